@@ -1,0 +1,1 @@
+"""EasyNav controllers: SimpleController."""

@@ -1,0 +1,38 @@
+"""The catalogue: which distribution of this project provides each known plugin name.
+
+Used to tell a user which package to install when a params file names a plugin that is not
+installed. Installed plugins are found through entry points, never through this table.
+"""
+
+from __future__ import annotations
+
+CATALOGUE: dict[str, str] = {
+    # Dummy and fault-injection plugins
+    "easynav_controller/DummyController": "easynav-core",
+    "easynav_localizer/DummyLocalizer": "easynav-core",
+    "easynav_planner/DummyPlanner": "easynav-core",
+    "easynav_maps_manager/DummyMapsManager": "easynav-core",
+    "easynav_recovery/DummyRecoveryManager": "easynav-core",
+    "easynav_controller/FaultyController": "easynav-faulty",
+    "easynav_localizer/FaultyLocalizer": "easynav-faulty",
+    "easynav_planner/FaultyPlanner": "easynav-faulty",
+    "easynav_maps_manager/FaultyMapsManager": "easynav-faulty",
+    # Simple stack
+    "easynav_simple_maps_manager/SimpleMapsManager": "easynav-maps",
+    "easynav_simple_localizer/AMCLLocalizer": "easynav-localizers",
+    "easynav_simple_planner/SimplePlanner": "easynav-planners",
+    "easynav_simple_controller/SimpleController": "easynav-controllers",
+    # Recovery systems
+    "easynav_simple_recovery/SimpleRecoveryManager": "easynav-recovery",
+    "easynav_diagnostic_recovery/DiagnosticRecoveryManager": "easynav-recovery",
+    # Costmap stack and others (catalogued so the error names the package once they exist)
+    "easynav_costmap_maps_manager/CostmapMapsManager": "easynav-maps",
+    "easynav_costmap_localizer/AMCLLocalizer": "easynav-localizers",
+    "easynav_costmap_planner/CostmapPlanner": "easynav-planners",
+    "easynav_regulated_pp_controller/RegulatedPurePursuitController": "easynav-controllers",
+    "easynav_mppi_controller/MPPIController": "easynav-controllers",
+    "easynav_vff_controller/VffController": "easynav-controllers",
+    "easynav_octomap_maps_manager/OctomapMapsManager": "easynav-maps",
+    "easynav_bonxai_maps_manager/BonxaiMapsManager": "easynav-maps",
+    "easynav_fusion_localizer/FusionLocalizer": "easynav-localizers",
+}

@@ -1,0 +1,72 @@
+"""PluginContext: what a host node hands to the plugins it loads."""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from easynav.core.robot import RobotGeometry, RobotLimits
+
+
+class ParameterAccess:
+    """Declare-if-absent-and-read access to a node's parameters.
+
+    The ROS implementation lives in ``easynav.core.system.node_parameters``; :class:`DictParameters`
+    serves tests and tools that run plugins without ROS.
+    """
+
+    def declare(self, name: str, default: Any, description: str = "") -> Any:
+        """Declare ``name`` with ``default`` unless declared already; return its value."""
+        raise NotImplementedError
+
+    def set(self, name: str, value: Any) -> None:
+        """Change a declared parameter's value."""
+        raise NotImplementedError
+
+
+class DictParameters(ParameterAccess):
+    """Parameters held in a dict: ``DictParameters({"simple.k_rot": 0.5})``."""
+
+    def __init__(self, values: dict[str, Any] | None = None) -> None:
+        self.values: dict[str, Any] = dict(values or {})
+        self.declared: dict[str, Any] = {}
+
+    def declare(self, name: str, default: Any, description: str = "") -> Any:
+        if name not in self.declared:
+            self.declared[name] = self.values.get(name, default)
+        return self.declared[name]
+
+    def set(self, name: str, value: Any) -> None:
+        self.values[name] = value
+        self.declared[name] = value
+
+
+def _monotonic_seconds() -> float:
+    return time.monotonic()
+
+
+@dataclass
+class PluginContext:
+    """Everything a plugin may use from its host.
+
+    ``node`` is the host rclpy lifecycle node (None when a plugin runs without ROS, e.g. in
+    unit tests): plugins create their debug publishers and subscriptions on it.
+    ``now`` returns the node clock in seconds (simulated time with ``use_sim_time``).
+    ``robot_limits`` returns the limits in force (cut down by a safely limited speed).
+    """
+
+    parameters: ParameterAccess = field(default_factory=DictParameters)
+    node: Any = None
+    node_name: str = ""
+    namespace: str = ""
+    system_rt_freq: float = 200.0
+    system_freq: float = 200.0
+    now: Callable[[], float] = _monotonic_seconds
+    logger: Any = field(default_factory=lambda: logging.getLogger("easynav"))
+    robot_geometry: Callable[[], RobotGeometry] = RobotGeometry
+    robot_limits: Callable[[], RobotLimits] = RobotLimits
+    # Recovery system actions and other host services, set by the hosts that offer them.
+    services: dict[str, Any] = field(default_factory=dict)

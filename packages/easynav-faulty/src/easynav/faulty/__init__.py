@@ -1,0 +1,1 @@
+"""EasyNav fault-injection plugins (FaultyController, FaultyLocalizer, FaultyPlanner, FaultyMapsManager)."""

@@ -1,0 +1,1 @@
+"""EasyNav localizers: the simple AMCL particle filter."""

@@ -1,0 +1,1 @@
+"""EasyNav maps managers: the simple binary grid (SimpleMap, SimpleMapsManager)."""

@@ -1,0 +1,1 @@
+"""EasyNav planners: SimplePlanner (A* on the simple grid)."""

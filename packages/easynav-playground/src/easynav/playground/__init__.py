@@ -1,0 +1,1 @@
+"""EasyNav playground: a 2D differential-drive simulator with a laser scanner, odometry and /clock, plus the demo."""

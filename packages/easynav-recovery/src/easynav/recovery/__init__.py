@@ -1,0 +1,1 @@
+"""EasyNav recovery systems: SimpleRecoveryManager and DiagnosticRecoveryManager."""
