@@ -1,0 +1,17 @@
+"""DummyMapsManager (easynav_maps_manager/DummyMapsManager): does nothing, optionally slowly."""
+
+from __future__ import annotations
+
+from easynav.core.dummy.busy_wait import busy_wait
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import MapsManagerBase
+
+
+class DummyMapsManager(MapsManagerBase):
+    """Keeps no map. Parameters: ``cycle_time_nort`` (s, busy-wait per update, 0.0)."""
+
+    def on_initialize(self) -> None:
+        self.cycle_time_nort = float(self.get_parameter("cycle_time_nort", 0.0))
+
+    def update(self, nav_state: NavState) -> None:
+        busy_wait(self.cycle_time_nort)
