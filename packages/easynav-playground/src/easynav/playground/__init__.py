@@ -1,1 +1,2 @@
-"""EasyNav playground: a 2D differential-drive simulator with a laser scanner, odometry and /clock, plus the demo."""
+"""EasyNav playground: a 2D differential-drive robot simulator (laser, odometry, /clock) and the
+demo that drives it through waypoints with EasyNav."""

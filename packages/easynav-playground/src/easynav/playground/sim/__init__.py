@@ -1,0 +1,29 @@
+"""The playground's simulator core: plain numpy, no ROS."""
+
+from easynav.playground.sim.base_limits import BaseLimits
+from easynav.playground.sim.collision import Collision
+from easynav.playground.sim.collision_checker import CollisionChecker
+from easynav.playground.sim.diff_drive_robot import DiffDriveRobot, integrate_unicycle
+from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
+from easynav.playground.sim.laser_scanner import LaserScanner
+from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.ray_casting import cast_rays_discs, cast_rays_grid
+from easynav.playground.sim.simulation import Simulation
+from easynav.playground.sim.wheel_odometry import WheelOdometry
+from easynav.playground.sim.world import World
+
+__all__ = [
+    "BaseLimits",
+    "Collision",
+    "CollisionChecker",
+    "DiffDriveRobot",
+    "GroundTruthRecorder",
+    "LaserScanner",
+    "MovingObstacle",
+    "Simulation",
+    "WheelOdometry",
+    "World",
+    "cast_rays_discs",
+    "cast_rays_grid",
+    "integrate_unicycle",
+]

@@ -1,0 +1,127 @@
+"""GroundTruthRecorder: what really happened in a run, for evaluating the navigation."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+
+class GroundTruthRecorder:
+    """Keeps the true trajectory, an estimated one when given, clearances and collisions.
+
+    Trajectories are lists of ``(stamp, x, y, yaw)``. The localisation error pairs each
+    estimate with the true pose interpolated at the estimate's stamp.
+
+    Thread contract: not thread-safe. In the playground the simulation loop records; in the
+    demo the executor thread records. Read results from the same thread or after the run.
+    """
+
+    def __init__(self) -> None:
+        self.true_poses: list[tuple[float, float, float, float]] = []
+        self.estimated_poses: list[tuple[float, float, float, float]] = []
+        self.clearances: list[tuple[float, float]] = []
+        self.collisions: list[dict] = []
+        self.min_clearance = math.inf
+        self.min_clearance_at: tuple[float, float, float] | None = None
+
+    def record_true(self, stamp: float, x: float, y: float, yaw: float) -> None:
+        """Add a true pose sample (stamps must not go backwards)."""
+        if self.true_poses and stamp < self.true_poses[-1][0]:
+            raise ValueError(
+                f"GroundTruthRecorder: true pose stamp {stamp} is older than the last one "
+                f"{self.true_poses[-1][0]}"
+            )
+        self.true_poses.append((float(stamp), float(x), float(y), float(yaw)))
+
+    def record_estimate(self, stamp: float, x: float, y: float, yaw: float) -> None:
+        """Add an estimated pose sample (from a localizer), in the same frame as the truth."""
+        self.estimated_poses.append((float(stamp), float(x), float(y), float(yaw)))
+
+    def record_clearance(self, stamp: float, x: float, y: float, clearance: float) -> None:
+        """Add the robot's clearance (m) to the nearest obstacle at ``(x, y)``."""
+        self.clearances.append((float(stamp), float(clearance)))
+        if clearance < self.min_clearance:
+            self.min_clearance = float(clearance)
+            self.min_clearance_at = (float(stamp), float(x), float(y))
+
+    def record_collision(self, collision: dict) -> None:
+        """Add a collision (``{"stamp", "x", "y", "with"}``)."""
+        self.collisions.append(dict(collision))
+
+    # ------------------------------------------------------------------ results
+    def distance_driven(self, start: float = -math.inf, end: float = math.inf) -> float:
+        """Length (m) of the true trajectory between two stamps."""
+        pts = np.array([p[1:3] for p in self.true_poses if start <= p[0] <= end])
+        if len(pts) < 2:
+            return 0.0
+        return float(np.hypot(*np.diff(pts, axis=0).T).sum())
+
+    def localisation_errors(self) -> np.ndarray:
+        """Position errors (m) of the estimates against the interpolated truth.
+
+        Estimates outside the span of the true trajectory are not paired (no extrapolation).
+        """
+        if len(self.true_poses) < 2 or not self.estimated_poses:
+            return np.zeros(0)
+        truth = np.array(self.true_poses)
+        est = np.array(self.estimated_poses)
+        inside = (est[:, 0] >= truth[0, 0]) & (est[:, 0] <= truth[-1, 0])
+        est = est[inside]
+        tx = np.interp(est[:, 0], truth[:, 0], truth[:, 1])
+        ty = np.interp(est[:, 0], truth[:, 0], truth[:, 2])
+        return np.hypot(est[:, 1] - tx, est[:, 2] - ty)
+
+    def true_pose_at(self, stamp: float) -> tuple[float, float] | None:
+        """The true position interpolated at ``stamp``, None outside the recorded span."""
+        if not self.true_poses or not self.true_poses[0][0] <= stamp <= self.true_poses[-1][0]:
+            return None
+        truth = np.array(self.true_poses)
+        return (
+            float(np.interp(stamp, truth[:, 0], truth[:, 1])),
+            float(np.interp(stamp, truth[:, 0], truth[:, 2])),
+        )
+
+    # ------------------------------------------------------------------ persistence
+    def to_dict(self) -> dict:
+        """A JSON-ready snapshot."""
+        return {
+            "true_poses": self.true_poses,
+            "estimated_poses": self.estimated_poses,
+            "clearances": self.clearances,
+            "collisions": self.collisions,
+            "min_clearance": None if math.isinf(self.min_clearance) else self.min_clearance,
+            "min_clearance_at": self.min_clearance_at,
+        }
+
+    def save(self, path: str | Path) -> None:
+        """Write :meth:`to_dict` as JSON (atomically: a reader never sees half a file)."""
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(json.dumps(self.to_dict()))
+        tmp.replace(path)
+
+    @classmethod
+    def load(cls, path: str | Path) -> GroundTruthRecorder:
+        """Read a file written by :meth:`save`.
+
+        Raises:
+            FileNotFoundError: no such file.
+            ValueError: not a recorder file (names the missing key).
+        """
+        data = json.loads(Path(path).read_text())
+        rec = cls()
+        for key in ("true_poses", "estimated_poses", "clearances", "collisions"):
+            if key not in data:
+                raise ValueError(f"{path}: not a ground-truth record (missing '{key}')")
+        rec.true_poses = [tuple(p) for p in data["true_poses"]]
+        rec.estimated_poses = [tuple(p) for p in data["estimated_poses"]]
+        rec.clearances = [tuple(c) for c in data["clearances"]]
+        rec.collisions = list(data["collisions"])
+        if data.get("min_clearance") is not None:
+            rec.min_clearance = float(data["min_clearance"])
+            at = data.get("min_clearance_at")
+            rec.min_clearance_at = tuple(at) if at else None
+        return rec

@@ -1,0 +1,153 @@
+"""WorldDescription: a world with its start pose, moving obstacles and default waypoints."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import yaml
+
+from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.world import World
+
+WORLDS_DIR = Path(str(resources.files("easynav.playground") / "worlds"))
+
+
+@dataclass
+class WorldDescription:
+    """Everything the playground needs to set up a run.
+
+    A description file (``worlds/home.yaml``) reads::
+
+        map: home.map                  # .map or map-server .yaml, relative to this file
+        start_pose: [5.6, 3.4, 0.0]    # x, y, yaw of the robot in the map frame
+        waypoints: home.waypoints.yaml # default waypoint list of the demo (optional)
+        moving_obstacles:              # optional
+          - {name: person, radius: 0.2, speed: 0.3, waypoints: [[5.0, 0.9], [6.2, 0.9]]}
+
+    Thread contract: plain data; build it before starting threads.
+    """
+
+    world: World
+    map_path: Path | None = None
+    start_pose: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    obstacles: list[dict] = field(default_factory=list)
+    waypoints_path: Path | None = None
+    source: str = ""
+
+    def make_obstacles(self) -> list[MovingObstacle]:
+        """Fresh :class:`MovingObstacle` objects (at their first waypoint).
+
+        Raises:
+            ValueError: a malformed obstacle entry (names the entry).
+        """
+        result = []
+        for i, spec in enumerate(self.obstacles):
+            if not isinstance(spec, dict) or "waypoints" not in spec:
+                raise ValueError(f"{self.source}: moving_obstacles[{i}] needs 'waypoints'")
+            unknown = set(spec) - {"name", "radius", "speed", "waypoints"}
+            if unknown:
+                raise ValueError(f"{self.source}: moving_obstacles[{i}] has unknown keys {unknown}")
+            result.append(
+                MovingObstacle(
+                    spec["waypoints"],
+                    radius=float(spec.get("radius", 0.25)),
+                    speed=float(spec.get("speed", 0.4)),
+                    name=str(spec.get("name", f"obstacle {i}")),
+                )
+            )
+        return result
+
+    @classmethod
+    def resolve(cls, spec: str) -> WorldDescription:
+        """Find a world from a name or a path.
+
+        ``spec`` may be the name of a shipped world (``home``, ``office``), a world description
+        YAML (has a ``map`` key), a map-server YAML (has an ``image`` key) or a ``.map`` file.
+        Plain maps start the robot at ``(0, 0, 0)`` with no obstacles.
+
+        Raises:
+            FileNotFoundError: neither a shipped world nor an existing file (lists the names).
+            ValueError: a malformed file.
+        """
+        shipped = WORLDS_DIR / f"{spec}.yaml"
+        if "/" not in spec and not spec.endswith((".yaml", ".yml", ".map")) and shipped.exists():
+            return cls.from_description_file(shipped)
+        path = Path(spec)
+        if not path.exists():
+            names = sorted(p.stem for p in WORLDS_DIR.glob("*.yaml") if ".waypoints" not in p.name)
+            raise FileNotFoundError(
+                f"world {spec!r}: no such file and not a shipped world (shipped: {names})"
+            )
+        if path.suffix.lower() == ".map":
+            return cls(World.from_map_file(path), map_path=path, source=str(path))
+        data = yaml.safe_load(path.read_text())
+        if isinstance(data, dict) and "map" in data:
+            return cls.from_description_file(path)
+        if isinstance(data, dict) and "image" in data:
+            return cls(World.from_ros_map_yaml(path), map_path=path, source=str(path))
+        raise ValueError(
+            f"{path}: neither a world description (key 'map') nor a map-server YAML (key 'image')"
+        )
+
+    @classmethod
+    def from_description_file(cls, path: str | Path) -> WorldDescription:
+        """Load a world description YAML (see the class documentation).
+
+        Raises:
+            ValueError: a missing ``map`` key, a malformed ``start_pose`` or unknown keys.
+        """
+        path = Path(path)
+        data = yaml.safe_load(path.read_text())
+        if not isinstance(data, dict) or "map" not in data:
+            raise ValueError(f"{path}: a world description needs a 'map' key")
+        unknown = set(data) - {"map", "start_pose", "waypoints", "moving_obstacles"}
+        if unknown:
+            raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
+        map_path = path.parent / data["map"]
+        world = World.load(map_path)
+        start = data.get("start_pose", [0.0, 0.0, 0.0])
+        if not (isinstance(start, list) and len(start) == 3):
+            raise ValueError(f"{path}: start_pose must be [x, y, yaw], got {start!r}")
+        start_pose = tuple(float(v) for v in start)
+        if not all(math.isfinite(v) for v in start_pose):
+            raise ValueError(f"{path}: start_pose must be finite, got {start!r}")
+        obstacles = data.get("moving_obstacles") or []
+        if not isinstance(obstacles, list):
+            raise ValueError(f"{path}: moving_obstacles must be a list")
+        waypoints = data.get("waypoints")
+        return cls(
+            world,
+            map_path=map_path,
+            start_pose=start_pose,
+            obstacles=obstacles,
+            waypoints_path=path.parent / waypoints if waypoints else None,
+            source=str(path),
+        )
+
+
+def load_waypoints(path: str | Path) -> list[tuple[float, float, float]]:
+    """Read a waypoint list: a YAML list of ``[x, y, yaw]`` (or ``{waypoints: [...]}``).
+
+    Raises:
+        FileNotFoundError: no such file.
+        ValueError: an entry that is not three finite numbers (names its index), or no entry.
+    """
+    path = Path(path)
+    data = yaml.safe_load(path.read_text())
+    if isinstance(data, dict):
+        data = data.get("waypoints")
+    if not isinstance(data, list) or not data:
+        raise ValueError(f"{path}: expected a non-empty list of [x, y, yaw]")
+    result = []
+    for i, entry in enumerate(data):
+        try:
+            x, y, yaw = (float(v) for v in entry)
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"{path}: waypoint {i} must be [x, y, yaw], got {entry!r}") from err
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise ValueError(f"{path}: waypoint {i} is not finite: {entry!r}")
+        result.append((x, y, yaw))
+    return result
