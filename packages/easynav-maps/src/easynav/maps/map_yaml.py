@@ -1,0 +1,174 @@
+"""Loading ROS map_server maps (a YAML file and a PGM/PNG image) as occupancy grids.
+
+map_server semantics (ROS 1 map_server / Nav2 map_io):
+
+- YAML keys: ``image`` (path, relative to the YAML's folder unless absolute), ``resolution``
+  (m/pixel), ``origin`` ``[x, y, yaw]`` (pose of the lower-left pixel), ``occupied_thresh``,
+  ``free_thresh`` (required), ``negate`` (0), ``mode`` (``trinary``, ``scale`` or ``raw``).
+- The pixel shade is the mean of its colour channels (alpha excluded) scaled to 0…1 (white = 1).
+  ``occ = 1 - shade`` (``shade`` when ``negate``).
+- trinary: ``occ > occupied_thresh`` → 100, ``occ < free_thresh`` → 0, else -1.
+- scale: as trinary, but a pixel that is not fully opaque is -1 and values in between map
+  linearly to 1…99 (``round(99 (occ - free) / (occupied - free))``).
+- raw: the grey value (0…255) itself when it is 0…100, else -1 (Nav2's rule).
+- The image's top row is the map's last row (y grows upwards in the map).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import yaml
+
+from easynav.core.types import Header, Pose
+from easynav.maps.map_format_error import MapFormatError
+from easynav.maps.occupancy_grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+
+MODES = ("trinary", "scale", "raw")
+
+
+def _number(doc: dict[str, Any], key: str, source: Path, default: Any = None) -> float:
+    if key not in doc:
+        if default is None:
+            raise MapFormatError(f"{source}: required key '{key}' is missing")
+        return float(default)
+    value = doc[key]
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise MapFormatError(f"{source}: '{key}' must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise MapFormatError(f"{source}: '{key}' must be finite, got {value!r}")
+    return float(value)
+
+
+def read_map_yaml(path: str | os.PathLike) -> dict[str, Any]:
+    """The validated contents of a map YAML: image path (resolved), numbers and mode.
+
+    Raises :class:`FileNotFoundError` or :class:`MapFormatError` naming the file and key.
+    """
+    source = Path(path)
+    if not source.is_file():
+        raise FileNotFoundError(f"map YAML not found: {source}")
+    try:
+        doc = yaml.safe_load(source.read_text())
+    except (yaml.YAMLError, UnicodeDecodeError) as exc:
+        raise MapFormatError(f"{source}: not valid YAML ({exc})") from None
+    if not isinstance(doc, dict):
+        raise MapFormatError(f"{source}: expected a mapping of keys (image, resolution, ...)")
+    image = doc.get("image")
+    if not isinstance(image, str) or not image:
+        raise MapFormatError(f"{source}: required key 'image' is missing or not a file name")
+    resolution = _number(doc, "resolution", source)
+    if resolution <= 0.0:
+        raise MapFormatError(f"{source}: 'resolution' must be > 0, got {resolution}")
+    origin = doc.get("origin")
+    if (
+        not isinstance(origin, list | tuple)
+        or len(origin) != 3
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in origin)
+        or not all(math.isfinite(v) for v in origin)
+    ):
+        raise MapFormatError(f"{source}: 'origin' must be [x, y, yaw] (finite), got {origin!r}")
+    occupied = _number(doc, "occupied_thresh", source)
+    free = _number(doc, "free_thresh", source)
+    if not 0.0 <= free <= occupied <= 1.0:
+        raise MapFormatError(
+            f"{source}: thresholds must satisfy 0 <= free_thresh ({free}) <= occupied_thresh "
+            f"({occupied}) <= 1"
+        )
+    negate = doc.get("negate", 0)
+    if negate not in (0, 1, True, False):
+        raise MapFormatError(f"{source}: 'negate' must be 0 or 1, got {negate!r}")
+    mode = str(doc.get("mode", "trinary")).lower()
+    if mode not in MODES:
+        raise MapFormatError(f"{source}: 'mode' must be one of {', '.join(MODES)}, got {mode!r}")
+    image_path = Path(image)
+    if not image_path.is_absolute():
+        image_path = source.parent / image_path
+    return {
+        "image": image_path,
+        "resolution": resolution,
+        "origin": tuple(float(v) for v in origin),
+        "occupied_thresh": occupied,
+        "free_thresh": free,
+        "negate": bool(negate),
+        "mode": mode,
+    }
+
+
+def image_to_occupancy(
+    image: np.ndarray, mode: str, occupied_thresh: float, free_thresh: float, negate: bool
+) -> np.ndarray:
+    """Occupancy values (int8, image orientation: row 0 is the top) of a map image.
+
+    ``image``: ``(H, W)`` grey, ``(H, W, 3)`` colour or ``(H, W, 4)`` colour + alpha, uint8 or
+    uint16 (as OpenCV reads it). Raises :class:`ValueError` for another layout or mode.
+    """
+    if mode not in MODES:
+        raise ValueError(f"map mode {mode!r} is not one of {', '.join(MODES)}")
+    if image.dtype == np.uint8:
+        full_scale = 255.0
+    elif image.dtype == np.uint16:
+        full_scale = 65535.0
+    else:
+        raise ValueError(f"map image must be 8 or 16 bit, got {image.dtype}")
+    alpha = None
+    if image.ndim == 2:
+        grey = image.astype(np.float64)
+    elif image.ndim == 3 and image.shape[2] in (1, 3, 4):
+        channels = image.shape[2]
+        colour = image[:, :, : 3 if channels >= 3 else 1].astype(np.float64)
+        grey = colour.mean(axis=2)
+        if channels == 4:
+            alpha = image[:, :, 3]
+    else:
+        raise ValueError(f"map image has an unsupported shape {image.shape}")
+    shade = grey / full_scale
+    if mode == "raw":
+        value = np.rint(shade * 255.0)
+        return np.where((value >= FREE) & (value <= OCCUPIED), value, UNKNOWN).astype(np.int8)
+    occ = shade if negate else 1.0 - shade
+    result = np.full(shade.shape, UNKNOWN, dtype=np.int8)
+    if mode == "scale":
+        span = occupied_thresh - free_thresh
+        if span > 0.0:
+            between = np.rint(99.0 * (occ - free_thresh) / span)
+            result = np.clip(between, 1, 99).astype(np.int8)
+    result[occ > occupied_thresh] = OCCUPIED
+    result[occ < free_thresh] = FREE
+    if mode == "scale" and alpha is not None:
+        result[alpha < np.iinfo(alpha.dtype).max] = UNKNOWN
+    return result
+
+
+def load_map_yaml(path: str | os.PathLike, frame_id: str = "map") -> OccupancyGrid:
+    """Load a ROS map_server map (YAML + image, read with OpenCV) as an :class:`OccupancyGrid`.
+
+    Raises :class:`FileNotFoundError` (YAML or image missing, naming it) or
+    :class:`MapFormatError` (bad key, unreadable image), naming the file.
+    """
+    info = read_map_yaml(path)
+    image_path: Path = info["image"]
+    if not image_path.is_file():
+        raise FileNotFoundError(f"map image not found: {image_path} (named by {path})")
+    image = cv2.imread(str(image_path), cv2.IMREAD_UNCHANGED)
+    if image is None:
+        raise MapFormatError(f"{image_path}: OpenCV cannot read this image (named by {path})")
+    # OpenCV orders channels BGR(A): the mean of the colours does not care, alpha stays last.
+    try:
+        occupancy = image_to_occupancy(
+            image, info["mode"], info["occupied_thresh"], info["free_thresh"], info["negate"]
+        )
+    except ValueError as exc:
+        raise MapFormatError(f"{image_path}: {exc}") from None
+    x, y, yaw = info["origin"]
+    return OccupancyGrid(
+        header=Header(stamp=0.0, frame_id=frame_id),
+        resolution=info["resolution"],
+        origin=Pose.from_xy_yaw(x, y, yaw),
+        data=np.ascontiguousarray(occupancy[::-1]),
+    )

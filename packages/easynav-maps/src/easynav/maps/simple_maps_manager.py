@@ -1,0 +1,239 @@
+"""SimpleMapsManager (easynav_simple_maps_manager/SimpleMapsManager): the simple binary map."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import MapsManagerBase, PluginConfigurationError
+from easynav.core.sensors import PointPerception, PointPerceptionsOps
+from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.tf import get_tf_buffer
+from easynav.maps.map_file_resolver import resolve_map_file
+from easynav.maps.map_format_error import MapFormatError
+from easynav.maps.occupancy_grid import OccupancyGrid
+from easynav.maps.simple_map import SimpleMap
+
+#: Fused points at or below this height (map frame, m) are ground, not obstacles (original).
+OBSTACLE_MIN_Z = 0.1
+#: Where savemap writes when no better place is known (the original's default map path).
+DEFAULT_SAVE_PATH = "/tmp/default.map"
+
+
+class SimpleMapsManager(MapsManagerBase):
+    """Loads a :class:`SimpleMap` and keeps a copy with the live obstacles.
+
+    Parameters (under ``<alias>.``): ``package`` and ``map_path_file`` (see
+    :func:`easynav.maps.resolve_map_file`; with ``package`` empty, ``map_path_file`` is a path;
+    a ``.yaml`` file is loaded as a ROS map_server map), ``save_map_path`` (where ``savemap``
+    writes; empty: the loaded file when it was given as a plain path, else ``/tmp/default.map``).
+    With neither ``package`` nor ``map_path_file`` set, no map is loaded and the manager waits for
+    one on ``incoming_map``.
+
+    NavState: reads every ungrouped :class:`PointPerception`; writes ``map.base`` (the static map),
+    ``map`` (a copy with every fused point above z 0.1 m in the map frame marked occupied) and
+    ``map_time`` (node time of that update, s).
+
+    ROS (when hosted by a node; skipped with ``node`` None): publishes ``<fqn>/<alias>/map``
+    (latched OccupancyGrid, re-sent whenever the static map changes) and
+    ``<fqn>/<alias>/dynamic_map`` (each update, only while subscribed); subscribes
+    ``<fqn>/<alias>/incoming_map`` (an OccupancyGrid that replaces both maps; unknown cells become
+    occupied); serves ``<fqn>/<alias>/savemap`` (std_srvs/Trigger: writes the static map as a
+    ``.map`` file at ``save_map_path``).
+
+    Thread contract: ``initialize``/``on_cleanup`` in the configuring thread, ``update`` in the
+    non-RT thread, ROS callbacks in the non-RT executor. The static map is replaced (never
+    mutated), so a callback swapping it races with nothing. Exceptions: configuration errors are
+    :class:`PluginConfigurationError` naming the parameter and the file.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._static_map: SimpleMap | None = None
+        self._map_file: Path | None = None
+        self._save_path = DEFAULT_SAVE_PATH
+        self._throttle = WarningThrottle(period=5.0)
+        self._ros: dict = {}
+
+    # -- configuration --------------------------------------------------------------------------
+    def on_initialize(self) -> None:
+        self._destroy_ros()
+        alias = self.plugin_name
+        package = str(self.get_parameter("package", "", "package holding the map (empty: path)"))
+        map_path_file = str(
+            self.get_parameter("map_path_file", "", "map file inside package, or a path")
+        )
+        save_map_path = str(
+            self.get_parameter("save_map_path", "", "where savemap writes the map (.map)")
+        )
+        self._static_map = None
+        self._map_file = None
+        if package or map_path_file:
+            if not map_path_file:
+                raise PluginConfigurationError(
+                    f"{alias}.map_path_file is empty while {alias}.package = {package!r}: name "
+                    f"the map file inside the package"
+                )
+            try:
+                self._map_file = resolve_map_file(package, map_path_file)
+            except (FileNotFoundError, ValueError) as exc:
+                raise PluginConfigurationError(
+                    f"{alias}.package / {alias}.map_path_file: {exc}"
+                ) from None
+            try:
+                self._static_map = SimpleMap.load(self._map_file)
+            except (FileNotFoundError, MapFormatError) as exc:
+                raise PluginConfigurationError(f"{alias}.map_path_file: {exc}") from None
+            self.logger.info(f"{alias}: loaded {self._static_map} from {self._map_file}")
+        else:
+            self.logger.warning(
+                f"{alias}: no map configured ({alias}.package and {alias}.map_path_file are "
+                f"empty): waiting for a map on incoming_map"
+            )
+        if save_map_path:
+            self._save_path = save_map_path
+        elif self._map_file is not None and not package:
+            self._save_path = str(self._map_file)
+        else:
+            self._save_path = DEFAULT_SAVE_PATH
+        if self.context.node is not None:
+            self._create_ros()
+
+    def on_cleanup(self) -> None:
+        self._destroy_ros()
+
+    # -- public API ---------------------------------------------------------------------------
+    @property
+    def static_map(self) -> SimpleMap | None:
+        """The static map in use (None until one is loaded or received)."""
+        return self._static_map
+
+    @property
+    def save_path(self) -> str:
+        """Where :meth:`save_map` writes."""
+        return self._save_path
+
+    def set_static_map(self, new_map: SimpleMap) -> None:
+        """Replace the static map (the next update rebuilds ``map`` from it). Any thread."""
+        if not isinstance(new_map, SimpleMap):
+            raise TypeError(f"set_static_map needs a SimpleMap, got {type(new_map).__name__}")
+        self._static_map = new_map
+        self._publish_static()
+
+    def set_occupancy_grid(self, grid: OccupancyGrid) -> None:
+        """Replace the static map by an occupancy grid (unknown cells become occupied).
+
+        Raises :class:`ValueError` for a grid a SimpleMap cannot hold (rotated, bad values).
+        """
+        self.set_static_map(SimpleMap.from_occupancy_grid(grid, unknown_as_occupied=True))
+
+    def save_map(self) -> tuple[bool, str]:
+        """Write the static map to :attr:`save_path`; ``(success, message)`` naming the file."""
+        static = self._static_map
+        if static is None:
+            return False, "no map to save: none was loaded or received"
+        try:
+            static.save(self._save_path)
+        except OSError as exc:
+            return False, f"Failed to save map to {self._save_path}: {exc}"
+        return True, f"Map successfully saved to: {self._save_path}"
+
+    # -- update -------------------------------------------------------------------------------
+    def update(self, nav_state: NavState) -> None:
+        """Rebuild ``map`` from ``map.base`` and the fused perceptions. Non-RT thread."""
+        static = self._static_map
+        if static is None:
+            self._throttle.warn(self.logger, "no-map", f"{self.plugin_name}: no map yet")
+            return
+        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        dynamic = static.copy()
+        perceptions = nav_state.get_no_group(PointPerception)
+        if perceptions:
+            points = (
+                PointPerceptionsOps(perceptions, get_tf_buffer(self.context.namespace), self.logger)
+                .fuse(tf_info.map_frame)
+                .filter((math.nan, math.nan, OBSTACLE_MIN_Z), (math.nan, math.nan, math.nan))
+                .as_points()
+            )
+            if len(points):
+                dynamic.mark_occupied(points[:, 0], points[:, 1])
+        else:
+            self._throttle.warn(
+                self.logger, "no-perceptions", f"{self.plugin_name}: no point perceptions"
+            )
+        now = self.now()
+        nav_state.set("map.base", static)
+        nav_state.set("map", dynamic)
+        nav_state.set("map_time", float(now))
+        self._publish_dynamic(dynamic, tf_info.map_frame, now)
+
+    # -- ROS ----------------------------------------------------------------------------------
+    def _create_ros(self) -> None:
+        from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
+        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+        from std_srvs.srv import Trigger
+
+        node = self.context.node
+        base = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}"
+        latched = QoSProfile(
+            depth=1,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        )
+        self._ros = {
+            "map": node.create_publisher(OccupancyGridMsg, f"{base}/map", latched),
+            "dynamic_map": node.create_publisher(OccupancyGridMsg, f"{base}/dynamic_map", 1),
+            "incoming_map": node.create_subscription(
+                OccupancyGridMsg, f"{base}/incoming_map", self._on_incoming_map, latched
+            ),
+            "savemap": node.create_service(Trigger, f"{base}/savemap", self._on_savemap),
+        }
+        self._publish_static()
+
+    def _destroy_ros(self) -> None:
+        node = self.context.node
+        ros, self._ros = self._ros, {}
+        if node is None:
+            return
+        for name, entity in ros.items():
+            if name == "incoming_map":
+                node.destroy_subscription(entity)
+            elif name == "savemap":
+                node.destroy_service(entity)
+            else:
+                node.destroy_publisher(entity)
+
+    def _publish_static(self) -> None:
+        publisher = self._ros.get("map")
+        static = self._static_map
+        if publisher is None or static is None:
+            return
+        from easynav.maps.ros_converters import occupancy_grid_to_msg
+
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
+        publisher.publish(occupancy_grid_to_msg(static.to_occupancy_grid(frame, self.now())))
+
+    def _publish_dynamic(self, dynamic: SimpleMap, frame: str, stamp: float) -> None:
+        publisher = self._ros.get("dynamic_map")
+        if publisher is None or publisher.get_subscription_count() == 0:
+            return
+        from easynav.maps.ros_converters import occupancy_grid_to_msg
+
+        publisher.publish(occupancy_grid_to_msg(dynamic.to_occupancy_grid(frame, stamp)))
+
+    def _on_incoming_map(self, msg) -> None:
+        from easynav.maps.ros_converters import occupancy_grid_from_msg
+
+        try:
+            self.set_occupancy_grid(occupancy_grid_from_msg(msg))
+        except ValueError as exc:
+            self.logger.error(f"{self.plugin_name}: incoming_map rejected, map kept: {exc}")
+            return
+        self.logger.info(f"{self.plugin_name}: map replaced from incoming_map: {self._static_map}")
+
+    def _on_savemap(self, request, response):
+        response.success, response.message = self.save_map()
+        log = self.logger.info if response.success else self.logger.error
+        log(f"{self.plugin_name}: savemap: {response.message}")
+        return response
