@@ -1,0 +1,56 @@
+"""Names and texts of the goal-manager protocol (REFERENCE.md §4–§5).
+
+These strings are part of the contract with the original EasyNav and its clients: tools match
+on them, so they are kept byte for byte (including the table's capitalisation).
+"""
+
+from __future__ import annotations
+
+# -- participants -------------------------------------------------------------------------------
+SYSTEM_USER_ID = "easynav_system"
+"""The goal manager's own id: it ignores messages carrying it."""
+
+INITPOSE_USER_ID = "easynav_system_initpose"
+"""The user id of requests made from ``goal_pose`` (e.g. RViz's "2D Goal Pose")."""
+
+CLIENT_ID_SUFFIX = "_goal_manager_client"
+"""A GoalManagerClient's id is ``<node name>`` + this suffix."""
+
+# -- topics (relative: the node's namespace applies) ----------------------------------------------
+CONTROL_TOPIC = "easynav_control"
+GOAL_POSE_TOPIC = "goal_pose"
+MANAGER_INFO_TOPIC = "easynav_manager_info"
+QUEUE_DEPTH = 100
+
+# -- status messages of the protocol table -------------------------------------------------------
+GOALS_EMPTY = "Goals are empty"
+GOAL_ACCEPTED = "Goal accepted"
+PREEMPTED_BY_OTHERS = "Navigation preempted by others"
+UNABLE_TO_PREEMPT = "Goal rejected; unable to preempt current active goal"
+CANCEL_NOT_YOURS = "Trying to cancel a navigation not commanded by you"
+NOTHING_TO_CANCEL = "Nothing to cancel; easynav is idle"
+GOAL_CANCELLED = "Goal cancelled"
+NOTHING_TO_PAUSE = "Nothing to pause; easynav is idle"
+NOTHING_TO_RESUME = "Nothing to resume; easynav is idle"
+NAVIGATION_PAUSED = "Navigation paused"
+NAVIGATION_RESUMED = "Navigation resumed"
+UNABLE_TO_PROCESS = "Unable to process message"
+NAVIGATION_FINISHED = "Navigation successfully finished"
+MISSION_ABORTED = "Mission aborted"
+"""ERROR text of ``abort_mission`` when it is given an empty reason."""
+
+# -- NavState keys and values ---------------------------------------------------------------------
+KEY_GOALS = "goals"
+KEY_NAVIGATION_STATE = "navigation_state"
+KEY_NAVIGATION_PAUSED = "navigation_paused"
+KEY_ROBOT_POSE = "robot_pose"
+KEY_PATH = "path"
+KEY_POSITION_TOLERANCE = "goal_tolerance.position"
+KEY_HEIGHT_TOLERANCE = "goal_tolerance.height"
+KEY_YAW_TOLERANCE = "goal_tolerance.yaw"
+
+NAVIGATION_IDLE = "IDLE"
+"""Value of NavState ``navigation_state`` (a ``str``) when there is no mission."""
+
+NAVIGATION_ACTIVE = "ACTIVE"
+"""Value of NavState ``navigation_state`` (a ``str``) while a mission is under way."""
