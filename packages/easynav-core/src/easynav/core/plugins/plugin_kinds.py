@@ -21,7 +21,9 @@ class PluginKind:
     host_node: str
 
 
-CONTROLLER = PluginKind("controller", "easynav.controllers", ControllerMethodBase, "controller_node")
+CONTROLLER = PluginKind(
+    "controller", "easynav.controllers", ControllerMethodBase, "controller_node"
+)
 LOCALIZER = PluginKind("localizer", "easynav.localizers", LocalizerMethodBase, "localizer_node")
 PLANNER = PluginKind("planner", "easynav.planners", PlannerMethodBase, "planner_node")
 MAPS_MANAGER = PluginKind(

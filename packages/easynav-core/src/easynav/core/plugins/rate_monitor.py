@@ -90,7 +90,9 @@ class RateMonitor:
         self._slow_since = None
         return self._emit(DiagnosticLevel.OK, f"{measured:.1f} Hz", measured)
 
-    def _emit(self, level: DiagnosticLevel, message: str, measured: float) -> DiagnosticStatus | None:
+    def _emit(
+        self, level: DiagnosticLevel, message: str, measured: float
+    ) -> DiagnosticStatus | None:
         # Written on changes only: the level, or the WARN message growing its duration.
         changed = level != self._level or (
             level == DiagnosticLevel.WARN

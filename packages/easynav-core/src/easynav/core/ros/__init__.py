@@ -1,0 +1,1 @@
+"""The ROS boundary: converters between ROS messages and EasyNav's native types."""

@@ -1,0 +1,253 @@
+"""ComponentNode: the lifecycle node that hosts one kind of plugin (base of the six sub-nodes)."""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+from typing import Any
+
+from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
+
+from easynav.core.diagnostics import write_diagnostic
+from easynav.core.plugins import MethodBase, PluginContext, RateMonitor
+from easynav.core.plugins.discovery import load_plugin_class
+from easynav.core.plugins.plugin_kinds import PluginKind
+from easynav.core.system.node_parameters import NodeParameters
+from easynav.core.system.system_context import SystemContext
+from easynav.core.types import DiagnosticLevel, DiagnosticStatus
+
+
+class ConfigurationError(RuntimeError):
+    """Configuring a node failed; the message names the parameter or plugin at fault."""
+
+
+class LoadedPlugin:
+    """A plugin instance with its alias and its rate monitors."""
+
+    __slots__ = ("alias", "name", "plugin", "rt_monitor", "monitor", "diag_name", "failing")
+
+    def __init__(self, alias: str, name: str, plugin: MethodBase, diag_name: str) -> None:
+        self.alias = alias
+        self.name = name
+        self.plugin = plugin
+        self.diag_name = diag_name
+        self.rt_monitor: RateMonitor | None = None
+        self.monitor: RateMonitor | None = None
+        self.failing = False
+
+
+class ComponentNode(LifecycleNode):
+    """A sub-node of system_node hosting the plugins of one kind.
+
+    Lifecycle transitions run in the thread that triggers them (system_node's configuring
+    thread); ``cycle_rt`` runs in the RT loop thread and ``cycle`` in the non-RT loop thread, only
+    while active. Plugin exceptions in cycles are contained: logged (at most once per second per
+    plugin), reported as ``diagnostics.<alias>.error`` and handled per kind.
+    """
+
+    KIND: PluginKind | None = None
+    TYPES_PARAMETER = ""
+    MAX_PLUGINS: int | None = 1
+    DEFAULT_ALIAS_PLUGIN: tuple[str, str] | None = None
+
+    def __init__(self, node_name: str, namespace: str, system: SystemContext, **kwargs: Any):
+        super().__init__(node_name, namespace=namespace, **kwargs)
+        self.system = system
+        self.nav_state = system.nav_state
+        self.params = NodeParameters(self)
+        self.plugins: list[LoadedPlugin] = []
+        self.error_message = ""
+        self.active = False
+        self._last_error_log: dict[str, float] = {}
+
+    # -- clock --------------------------------------------------------------------------------
+    def now_seconds(self) -> float:
+        """This node's clock in seconds (simulated time with use_sim_time)."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def lifecycle_state(self) -> str:
+        """Label of the current lifecycle state (unconfigured, inactive, active, finalized)."""
+        return self._state_machine.current_state[1]
+
+    # -- lifecycle ----------------------------------------------------------------------------
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.error_message = ""
+        try:
+            self.configure_node()
+            self.load_plugins()
+            self.after_plugins_loaded()
+        except Exception as exc:  # any failure fails configure, naming the culprit
+            self.error_message = str(exc) or type(exc).__name__
+            self.get_logger().error(f"configure failed: {self.error_message}")
+            if not isinstance(exc, ConfigurationError | ValueError | LookupError | ImportError):
+                self.get_logger().debug(traceback.format_exc())
+            self.release_plugins()
+            return TransitionCallbackReturn.FAILURE
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        for lp in self.plugins:
+            for monitor in (lp.rt_monitor, lp.monitor):
+                if monitor is not None:
+                    monitor.restart()
+            lp.plugin.rt_schedule.reset()
+            lp.plugin.schedule.reset()
+        self.active = True
+        return super().on_activate(state)
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        self.release_plugins()
+        self.cleanup_node()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        self.release_plugins()
+        self.cleanup_node()
+        return TransitionCallbackReturn.SUCCESS
+
+    # -- hooks for sub-classes ----------------------------------------------------------------
+    def configure_node(self) -> None:
+        """Declare and check the node's own parameters (before plugins load)."""
+
+    def after_plugins_loaded(self) -> None:
+        """Anything that needs the plugins (after they load)."""
+
+    def cleanup_node(self) -> None:
+        """Release what ``configure_node`` created."""
+
+    # -- plugins ------------------------------------------------------------------------------
+    def plugin_context(self) -> PluginContext:
+        """The context handed to this node's plugins."""
+        return PluginContext(
+            parameters=self.params,
+            node=self,
+            node_name=self.get_name(),
+            namespace=self.system.namespace,
+            system_rt_freq=self.system.system_rt_freq,
+            system_freq=self.system.system_freq,
+            now=self.now_seconds,
+            logger=self.get_logger(),
+            robot_geometry=self.system.robot_geometry,
+            robot_limits=self.system.robot_limits,
+            services=self.system.services,
+        )
+
+    def plugin_aliases(self) -> list[tuple[str, str]]:
+        """``(alias, plugin name)`` pairs this node must load, from its parameters."""
+        if self.DEFAULT_ALIAS_PLUGIN is not None:
+            alias, default = self.DEFAULT_ALIAS_PLUGIN
+            return [(alias, str(self.params.declare(f"{alias}.plugin", default)))]
+        aliases = list(self.params.declare(self.TYPES_PARAMETER, []))
+        node = self.get_name()
+        if self.MAX_PLUGINS is not None and len(aliases) > self.MAX_PLUGINS:
+            raise ConfigurationError(
+                f"{node}.{self.TYPES_PARAMETER} lists {len(aliases)} plugins {aliases}: "
+                f"at most {self.MAX_PLUGINS} {self.KIND.name} can be loaded"
+            )
+        if len(set(aliases)) != len(aliases):
+            raise ConfigurationError(f"{node}.{self.TYPES_PARAMETER} repeats an alias: {aliases}")
+        pairs = []
+        for alias in aliases:
+            name = str(self.params.declare(f"{alias}.plugin", ""))
+            if not name:
+                raise ConfigurationError(
+                    f"{node}.{alias}.plugin is not set: every alias in "
+                    f"{node}.{self.TYPES_PARAMETER} needs a plugin name"
+                )
+            pairs.append((alias, name))
+        return pairs
+
+    def load_plugins(self) -> None:
+        """Load, initialise and monitor every plugin; all or nothing (raises on failure)."""
+        self.release_plugins()
+        node = self.get_name()
+        context = self.plugin_context()
+        for alias, name in self.plugin_aliases():
+            cls = load_plugin_class(self.KIND, name, f"{node}.{alias}.plugin")
+            plugin = cls()
+            try:
+                plugin.initialize(context, alias)
+            except Exception as exc:
+                raise ConfigurationError(f"{node}: plugin '{name}' ({alias}): {exc}") from exc
+            lp = LoadedPlugin(alias, name, plugin, self.system.diagnostic_name(node, alias))
+            if plugin.HAS_RT_UPDATE and self.MONITOR_RT:
+                lp.rt_monitor = RateMonitor(
+                    f"{lp.diag_name}.rt_rate", plugin.rt_freq, node, f"{alias}.rt_freq"
+                )
+            if plugin.HAS_UPDATE and self.MONITOR_NON_RT:
+                lp.monitor = RateMonitor(f"{lp.diag_name}.rate", plugin.freq, node, f"{alias}.freq")
+            self.plugins.append(lp)
+
+    #: Which rates are monitored for this node's plugins (REFERENCE: rt_rate for controllers and
+    #: localizer RT updates; rate for localizer, maps manager, planner and recovery evaluators).
+    MONITOR_RT = True
+    MONITOR_NON_RT = True
+
+    def release_plugins(self) -> None:
+        """Let every plugin release its resources, then forget them."""
+        for lp in self.plugins:
+            try:
+                lp.plugin.on_cleanup()
+            except Exception as exc:
+                self.get_logger().warning(f"{lp.alias}: on_cleanup failed: {exc}")
+        self.plugins = []
+
+    def loaded_plugins(self) -> list[tuple[str, str]]:
+        """``(alias, plugin name)`` of the loaded plugins (for the configuration log)."""
+        return [(lp.alias, lp.name) for lp in self.plugins]
+
+    # -- cycle helpers ------------------------------------------------------------------------
+    def check_rate(self, lp: LoadedPlugin, monitor: RateMonitor | None, now: float) -> None:
+        """Feed a rate monitor and write its diagnostic when it changes."""
+        if monitor is None:
+            return
+        status = monitor.check(now)
+        if status is not None:
+            write_diagnostic(self.nav_state, monitor.name, status)
+
+    def run_plugin(self, lp: LoadedPlugin, method: str) -> tuple[bool, Any]:
+        """Call ``lp.plugin.<method>(nav_state)``; contain and report exceptions.
+
+        Returns ``(ok, result)``. An exception is logged at most once per second, reported as an
+        ERROR ``diagnostics.<alias>.error`` while it repeats, and OK again after a clean run.
+        """
+        try:
+            result = getattr(lp.plugin, method)(self.nav_state)
+        except Exception as exc:
+            now = time.monotonic()
+            key = f"{lp.alias}.{method}"
+            if now - self._last_error_log.get(key, -math.inf) >= 1.0:
+                self._last_error_log[key] = now
+                self.get_logger().error(
+                    f"{lp.name} ({lp.alias}).{method} raised {type(exc).__name__}: {exc}"
+                )
+            if not lp.failing:
+                lp.failing = True
+                write_diagnostic(
+                    self.nav_state,
+                    f"{lp.diag_name}.error",
+                    DiagnosticStatus(
+                        DiagnosticLevel.ERROR,
+                        message=f"{method} raised {type(exc).__name__}: {exc}",
+                        hardware_id=self.get_name(),
+                        values={"plugin": lp.name},
+                    ),
+                )
+            return False, None
+        if lp.failing:
+            lp.failing = False
+            write_diagnostic(
+                self.nav_state,
+                f"{lp.diag_name}.error",
+                DiagnosticStatus(
+                    DiagnosticLevel.OK, message="running", hardware_id=self.get_name()
+                ),
+            )
+        return True, result

@@ -1,0 +1,249 @@
+"""ControllerNode: hosts the controller and is EasyNav's single velocity output."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+from geometry_msgs.msg import Twist as TwistMsg
+from geometry_msgs.msg import TwistStamped as TwistStampedMsg
+from rclpy.duration import Duration
+from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
+from rclpy.qos import (
+    QoSDurabilityPolicy,
+    QoSHistoryPolicy,
+    QoSLivelinessPolicy,
+    QoSProfile,
+    QoSReliabilityPolicy,
+)
+
+from easynav.core.diagnostics import write_diagnostic
+from easynav.core.plugins.plugin_kinds import CONTROLLER
+from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
+from easynav.core.ros.converters import header_to_msg, twist_to_msg
+from easynav.core.system.component_node import ComponentNode, ConfigurationError
+from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
+from easynav.core.velocity import VelocityOutput
+
+# Former per-controller limit parameters and the robot_limits field each one stands for.
+DEPRECATED_LIMIT_PARAMETERS = {
+    "max_linear_speed": "max_linear_vel",
+    "max_angular_speed": "max_angular_vel",
+    "max_linear_acc": "max_linear_acc",
+    "max_angular_acc": "max_angular_acc",
+}
+
+# NavState keys of the velocity proposals (they last one RT cycle).
+PROPOSAL_TAKEOVER = "cmd_vel.proposal.takeover"
+PROPOSAL_OVERRIDE = "cmd_vel.proposal.override"
+
+
+class ControllerNode(ComponentNode):
+    """controller_node: runs the controller plugin and publishes the one velocity command.
+
+    Every RT cycle: the controller computes ``cmd_vel`` (when due or triggered); after the
+    recovery system proposed, :meth:`publish_cycle` selects (mux), smooths, guards and publishes.
+    Parameters: ``controller_types``, ``<alias>.*``, ``robot_limits.*``, ``cmd_timeout`` (0.5 s),
+    ``cmd_vel_keepalive_period`` (0.0 s), ``use_cmd_vel_stamped`` (false).
+
+    Thread contract: ``cycle_rt``/``publish_cycle`` in the RT thread; ``brake`` in the thread that
+    deactivates or shuts down, while the RT loop no longer cycles.
+    """
+
+    KIND = CONTROLLER
+    TYPES_PARAMETER = "controller_types"
+    MAX_PLUGINS = 1
+    MONITOR_NON_RT = False
+
+    def __init__(self, namespace, system, **kwargs):
+        super().__init__("controller_node", namespace, system, **kwargs)
+        self.robot_limits = RobotLimits()
+        self.velocity_output: VelocityOutput | None = None
+        self.cmd_publisher = None
+        self.use_stamped = False
+        self.forced_use_stamped: bool | None = None
+        self.last_published = Twist()
+        self.published_any = False
+        system.robot_limits = self.limits_in_force
+
+    # -- configuration --------------------------------------------------------------------------
+    def configure_node(self) -> None:
+        node = self.get_name()
+        values = {
+            name: float(self.params.declare(f"robot_limits.{name}", default))
+            for name, default in DEFAULT_ROBOT_LIMITS.items()
+        }
+        self.robot_limits = RobotLimits(**values)
+        self.cmd_timeout = float(self.params.declare("cmd_timeout", 0.5))
+        self.keepalive_period = float(self.params.declare("cmd_vel_keepalive_period", 0.0))
+        stamped = bool(self.params.declare("use_cmd_vel_stamped", False))
+        if self.forced_use_stamped is not None and "use_cmd_vel_stamped" not in (
+            self._parameter_overrides
+        ):
+            stamped = self.forced_use_stamped
+        self.use_stamped = stamped
+        errors = self.robot_limits.validation_errors(f"{node}.robot_limits.")
+        for name, value in (
+            ("cmd_timeout", self.cmd_timeout),
+            ("cmd_vel_keepalive_period", self.keepalive_period),
+        ):
+            if not (value >= 0.0 and value != float("inf")):
+                errors.append(f"{node}.{name} = {value} must be finite and >= 0")
+        if errors:
+            raise ConfigurationError("; ".join(errors))
+
+    def after_plugins_loaded(self) -> None:
+        self._apply_deprecated_limits()
+        for lp in self.plugins:
+            period = 1.0 / lp.plugin.rt_freq
+            if self.cmd_timeout > 0.0 and self.cmd_timeout <= period:
+                raise ConfigurationError(
+                    f"{self.get_name()}.cmd_timeout = {self.cmd_timeout:g} s must be longer than "
+                    f"the controller's period ({lp.alias}.rt_freq = {lp.plugin.rt_freq:g} Hz, "
+                    f"{period:g} s)"
+                )
+        self.velocity_output = VelocityOutput(
+            self.robot_limits, self.cmd_timeout, self.keepalive_period
+        )
+        self._create_publisher()
+
+    def _apply_deprecated_limits(self) -> None:
+        overrides = self._parameter_overrides
+        for lp in self.plugins:
+            for old, new in DEPRECATED_LIMIT_PARAMETERS.items():
+                old_name = f"{lp.alias}.{old}"
+                if old_name in overrides and f"robot_limits.{new}" not in overrides:
+                    value = float(overrides[old_name].value)
+                    self.get_logger().warning(
+                        f"{old_name} is deprecated: use robot_limits.{new} (applied: {value})"
+                    )
+                    self.robot_limits = replace(self.robot_limits, **{new: value})
+        errors = self.robot_limits.validation_errors(f"{self.get_name()}.robot_limits.")
+        if errors:
+            raise ConfigurationError("; ".join(errors))
+
+    def _create_publisher(self) -> None:
+        if self.cmd_publisher is not None:
+            self.destroy_publisher(self.cmd_publisher)
+        qos = QoSProfile(
+            history=QoSHistoryPolicy.KEEP_LAST,
+            depth=1,  # only the latest command matters
+            reliability=QoSReliabilityPolicy.RELIABLE,
+            durability=QoSDurabilityPolicy.VOLATILE,
+        )
+        if self.keepalive_period > 0.0:
+            # A receiver that requests a deadline learns when EasyNav stops commanding.
+            # MANUAL_BY_TOPIC: AUTOMATIC reports false losses in this rclpy (ENVIRONMENT.md).
+            lease = Duration(seconds=2.0 * self.keepalive_period)
+            qos.deadline = lease
+            qos.liveliness = QoSLivelinessPolicy.MANUAL_BY_TOPIC
+            qos.liveliness_lease_duration = lease
+        if self.use_stamped:
+            self.cmd_publisher = self.create_publisher(TwistStampedMsg, "cmd_vel_stamped", qos)
+        else:
+            self.cmd_publisher = self.create_publisher(TwistMsg, "cmd_vel", qos)
+
+    def cleanup_node(self) -> None:
+        self.velocity_output = None
+        # The publisher is kept: braking to zero after a cleanup must still reach the driver.
+
+    # -- robot limits -----------------------------------------------------------------------------
+    def limits_in_force(self) -> RobotLimits:
+        """robot_limits, cut down by a safely limited speed when the safety channel says so."""
+        limits = self.robot_limits
+        if self.nav_state.has("safety_status"):
+            state = self.nav_state.get("safety_status", SafetyChannelState)
+            if state.valid and state.speed_limited:
+                limits = limits.cut_down(state.max_linear_vel, state.max_angular_vel)
+        return limits
+
+    # -- RT cycle ---------------------------------------------------------------------------------
+    def cycle_rt(self, trigger: bool) -> None:
+        """Run the controller when due or triggered. RT thread."""
+        if not self.active:
+            return
+        now = self.now_seconds()
+        for lp in self.plugins:
+            if lp.plugin.is_time_to_run_rt(now) or trigger:
+                if trigger:
+                    lp.plugin.rt_schedule.restart(now)
+                ok, _ = self.run_plugin(lp, "update_rt")
+                if not ok:
+                    # A failing controller stops the robot: a new zero command (braked smoothly).
+                    self.nav_state.set("cmd_vel", TwistStamped(Header(now, ""), Twist()))
+                if lp.rt_monitor is not None:
+                    lp.rt_monitor.record_run()
+            self.check_rate(lp, lp.rt_monitor, now)
+
+    def publish_cycle(self) -> None:
+        """Mux → smoother → guard → publish. RT thread, after the recovery system's RT cycle."""
+        output = self.velocity_output
+        if output is None or not self.active:
+            return
+        nav_state = self.nav_state
+        now = self.now_seconds()
+        controller_cmd = nav_state.get("cmd_vel") if nav_state.has("cmd_vel") else None
+        takeover = nav_state.get("cmd_vel.proposal.takeover") if nav_state.has(
+            PROPOSAL_TAKEOVER
+        ) else None
+        override = nav_state.get(PROPOSAL_OVERRIDE) if nav_state.has(PROPOSAL_OVERRIDE) else None
+        paused = bool(nav_state.get_or("navigation_paused", False))
+        safety = nav_state.get("safety_status") if nav_state.has("safety_status") else None
+        inhibited = bool(nav_state.get_or("motion_inhibited", False))
+        output.set_limits(self.limits_in_force())
+        command = output.cycle(now, controller_cmd, takeover, override, paused, safety, inhibited)
+        # Proposals last one cycle.
+        if takeover is not None:
+            nav_state.erase(PROPOSAL_TAKEOVER)
+        if override is not None:
+            nav_state.erase(PROPOSAL_OVERRIDE)
+        for status in command.diagnostics:
+            write_diagnostic(nav_state, status.name or "cmd_vel", status)
+        if command.publish:
+            self.publish_twist(command.twist, now)
+
+    def publish_twist(self, twist: Twist, now: float) -> None:
+        """Publish one command (Twist or TwistStamped). Any thread; not concurrently."""
+        if self.cmd_publisher is None:
+            return
+        if self.use_stamped:
+            msg = TwistStampedMsg()
+            msg.header = header_to_msg(Header(now, self.robot_frame()))
+            msg.twist = twist_to_msg(twist)
+        else:
+            msg = twist_to_msg(twist)
+        self.cmd_publisher.publish(msg)
+        if self.keepalive_period > 0.0:
+            self.cmd_publisher.assert_liveliness()
+        self.last_published = twist
+        self.published_any = True
+
+    def robot_frame(self) -> str:
+        tf_info = self.system.services.get("tf_info")
+        return tf_info().robot_frame if tf_info else "base_link"
+
+    # -- braking ----------------------------------------------------------------------------------
+    def brake(self) -> None:
+        """Brake within the deceleration limits and end with an exact zero command.
+
+        Runs in the calling thread at the system RT period (the RT loop no longer cycles).
+        """
+        output = self.velocity_output
+        period = 1.0 / self.system.system_rt_freq
+        if output is not None and self.published_any:
+            deadline = time.monotonic()
+            for twist in output.brake_sequence(self.now_seconds(), period):
+                self.publish_twist(twist, self.now_seconds())
+                deadline += period
+                delay = deadline - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
+        if self.cmd_publisher is not None:
+            self.publish_twist(Twist(), self.now_seconds())  # always end with an exact zero
+        if output is not None:
+            output.reset()
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        self.brake()
+        return super().on_deactivate(state)

@@ -1,0 +1,125 @@
+"""CycleLoop: a thread that runs a cycle at a fixed frequency with absolute deadlines."""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from collections.abc import Callable
+
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+
+
+class CycleLoop(threading.Thread):
+    """Runs ``cycle(triggered)`` every ``1/freq`` s on the monotonic clock, in its own thread.
+
+    Deadlines are absolute (``start + k·period``): the loop does not drift. A loop that falls
+    more than one period behind restarts its schedule from now (no burst of catch-up cycles).
+    Between cycles it spins its executor until the next deadline, so ROS callbacks are served as
+    they arrive; after a cycle that overran, it still spins for at most ``spin_time`` so callbacks
+    are not starved. With ``wake`` (the RT loop), a callback that brings new sensor data runs a
+    triggered cycle at once, keeping perception-to-action latency low.
+
+    With ``realtime`` the thread asks for SCHED_FIFO ``priority`` (a warning, and normal priority,
+    where it is not permitted). ``on_realtime_result(ok, message)`` reports the outcome.
+
+    Thread contract: ``start``/``stop`` from the owner's thread; ``cycle`` and ``wake`` run in the
+    loop's thread. Exceptions from ``cycle`` are logged through ``on_error`` and the loop goes on.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        freq: float,
+        executor: SingleThreadedExecutor,
+        cycle: Callable[[bool], None],
+        spin_time: float,
+        wake: Callable[[], bool] | None = None,
+        realtime: bool = False,
+        priority: int = 80,
+        on_realtime_result: Callable[[bool, str], None] | None = None,
+        on_error: Callable[[BaseException], None] | None = None,
+    ) -> None:
+        super().__init__(name=name, daemon=True)
+        self.period = 1.0 / freq
+        self.executor = executor
+        self.cycle = cycle
+        self.spin_time = spin_time
+        self.wake = wake
+        self.realtime = realtime
+        self.priority = priority
+        self.on_realtime_result = on_realtime_result
+        self.on_error = on_error
+        self._stop_event = threading.Event()
+        self.cycles = 0
+        self.triggered_cycles = 0
+
+    def stop(self) -> None:
+        """Ask the loop to end after its current step."""
+        self._stop_event.set()
+
+    def _become_realtime(self) -> None:
+        if not self.realtime:
+            return
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(self.priority))
+            ok, message = True, f"{self.name}: SCHED_FIFO priority {self.priority}"
+        except (PermissionError, OSError) as exc:
+            ok = False
+            message = (
+                f"{self.name}: SCHED_FIFO priority {self.priority} not permitted ({exc}); running "
+                f"at normal priority. Grant RLIMIT_RTPRIO >= {self.priority} (limits.d rtprio, "
+                f"systemd LimitRTPRIO, docker --ulimit rtprio) or set use_real_time: false"
+            )
+        if self.on_realtime_result is not None:
+            self.on_realtime_result(ok, message)
+
+    def _run_cycle(self, triggered: bool) -> None:
+        try:
+            self.cycle(triggered)
+        except Exception as exc:  # a cycle must never kill the loop
+            if self.on_error is not None:
+                self.on_error(exc)
+        self.cycles += 1
+        if triggered:
+            self.triggered_cycles += 1
+
+    def _spin(self, timeout: float) -> bool:
+        """Serve at most one callback; False when the executor is gone."""
+        try:
+            self.executor.spin_once(timeout_sec=max(0.0, timeout))
+        except (ExternalShutdownException, KeyboardInterrupt):
+            return False
+        except Exception as exc:
+            if self._stop_event.is_set():
+                return False
+            if self.on_error is not None:
+                self.on_error(exc)
+        return True
+
+    def run(self) -> None:
+        self._become_realtime()
+        period = self.period
+        stop = self._stop_event
+        monotonic = time.monotonic
+        deadline = monotonic()
+        while not stop.is_set():
+            now = monotonic()
+            if now >= deadline:
+                self._run_cycle(False)
+                deadline += period
+                end_of_cycle = monotonic()
+                if end_of_cycle > deadline + period:  # more than one period behind: restart
+                    deadline = end_of_cycle + period
+                spin_until = end_of_cycle + self.spin_time
+                # Overran: serve pending callbacks for at most spin_time, then cycle again.
+                while monotonic() < min(spin_until, deadline + period) and monotonic() >= deadline:
+                    if not self._spin(0.0):
+                        return
+                    if stop.is_set():
+                        return
+                continue
+            if not self._spin(deadline - now):
+                return
+            if self.wake is not None and self.wake():
+                self._run_cycle(True)

@@ -1,0 +1,72 @@
+"""NodeParameters: declare-if-absent-and-read parameters on an rclpy node."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.exceptions import InvalidParameterTypeException, ParameterException
+from rclpy.parameter import Parameter
+
+from easynav.core.plugins.plugin_context import ParameterAccess
+
+
+class ParameterError(ValueError):
+    """A parameter has a value of the wrong type or cannot be declared; names the parameter."""
+
+
+class NodeParameters(ParameterAccess):
+    """:class:`ParameterAccess` backed by an rclpy node.
+
+    Values come from the params file (parameter overrides) or the default. An integer written
+    where a double is expected (``rt_freq: 30``) is accepted as a double, as users of the C++
+    original expect YAML numbers to be numbers; any other type mismatch is a
+    :class:`ParameterError` naming ``<node>.<parameter>``.
+
+    Thread contract: configuring thread (lifecycle transitions), or any thread for reads of
+    declared parameters.
+    """
+
+    def __init__(self, node: Any) -> None:
+        self._node = node
+
+    def declare(self, name: str, default: Any, description: str = "") -> Any:
+        node = self._node
+        if node.has_parameter(name):
+            return node.get_parameter(name).value
+        descriptor = ParameterDescriptor(description=description)
+        override = node._parameter_overrides.get(name)  # rclpy keeps them here, by full name
+        try:
+            if isinstance(default, list) and not default:
+                # An empty list has no type of its own: the override's type wins, strings else.
+                if override is not None:
+                    node.declare_parameter(name, override.value, descriptor, ignore_override=True)
+                else:
+                    node.declare_parameter(name, Parameter.Type.STRING_ARRAY, descriptor)
+                    return []
+            elif (
+                override is not None
+                and isinstance(default, float)
+                and type(override.value) is int
+            ):
+                node.declare_parameter(name, float(override.value), descriptor, True)
+            else:
+                node.declare_parameter(name, default, descriptor)
+        except InvalidParameterTypeException as exc:
+            got = override.value if override is not None else None
+            raise ParameterError(
+                f"{node.get_name()}.{name} = {got!r} has the wrong type: expected "
+                f"{type(default).__name__} like the default {default!r}"
+            ) from exc
+        except ParameterException as exc:
+            raise ParameterError(f"{node.get_name()}.{name}: {exc}") from exc
+        return node.get_parameter(name).value
+
+    def set(self, name: str, value: Any) -> None:
+        result = self._node.set_parameters([Parameter(name, value=value)])[0]
+        if not result.successful:
+            raise ParameterError(f"{self._node.get_name()}.{name}: {result.reason}")
+
+    def get(self, name: str) -> Any:
+        """The value of a declared parameter."""
+        return self._node.get_parameter(name).value

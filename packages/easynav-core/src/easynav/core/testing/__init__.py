@@ -1,0 +1,1 @@
+"""Test helpers shared by every EasyNav package: DDS isolation and rclpy fixtures."""

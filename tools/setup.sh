@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Set up (or bring up to date) the development environment of EasyNav for Python:
+#   .venv/ at the repository root with every package installed (editable), the ROS 2 message
+#   packages built from their .msg files, and the test tools.
+# Idempotent and quick when nothing changed (a stamp per step). Needs Python 3.11 and, as root,
+# nothing else: every Python dependency comes from PyPI (ROS 2 Jazzy wheels included).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+VENV=$ROOT/.venv
+STAMPS=$VENV/.easynav-stamps
+
+log() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
+
+find_python() {
+  for candidate in python3.11 python3 python; do
+    if command -v "$candidate" >/dev/null 2>&1 &&
+       "$candidate" -c 'import sys; sys.exit(0 if sys.version_info[:2] == (3, 11) else 1)' 2>/dev/null; then
+      command -v "$candidate"; return 0
+    fi
+  done
+  return 1
+}
+
+# System packages: none are needed by the packages themselves. (The benchmark's optional open3d
+# comparison needs libusb-1.0-0; it prints a note instead of a figure when it is missing.)
+
+if [ ! -x "$VENV/bin/python" ]; then
+  PY=$(find_python) || { echo "setup: Python 3.11 is required (python3.11 not found)" >&2; exit 1; }
+  log "creating $VENV with $PY"
+  "$PY" -m venv "$VENV"
+fi
+mkdir -p "$STAMPS"
+PIP=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
+
+hash_of() { cat "$@" 2>/dev/null | sha256sum | cut -c1-16; }
+
+# 1. Build tools (a new venv has setuptools 65, too old for the message build).
+step=$(hash_of packages/easynav-interfaces/tools/build_requirements.txt requirements-dev.txt)
+if [ "$(cat "$STAMPS/tools" 2>/dev/null)" != "$step" ]; then
+  log "installing build and test tools"
+  "${PIP[@]}" --upgrade pip "setuptools>=77" wheel hatchling editables
+  "${PIP[@]}" -r packages/easynav-interfaces/tools/build_requirements.txt -r requirements-dev.txt
+  echo "$step" > "$STAMPS/tools"
+fi
+
+# 2. The ROS message packages (CMake build of .msg files; ~10 s).
+step=$(cd packages/easynav-interfaces && find . -path ./build -prune -o -type f \
+  \( -name '*.msg' -o -name 'CMakeLists.txt' -o -name 'package.xml' -o -name 'setup.py' \
+  -o -name 'pyproject.toml' -o -name '*.cmake' \) -print | sort | xargs cat | sha256sum | cut -c1-16)
+if [ "$(cat "$STAMPS/interfaces" 2>/dev/null)" != "$step" ] ||
+   ! "$VENV/bin/python" -c 'import easynav_interfaces.msg, tf2_msgs.msg, vision_msgs.msg' 2>/dev/null; then
+  log "building the ROS message packages (easynav_interfaces, tf2_msgs, vision_msgs)"
+  "${PIP[@]}" --no-build-isolation ./packages/easynav-interfaces
+  echo "$step" > "$STAMPS/interfaces"
+fi
+
+# 3. Every Python package, editable, with its dependencies.
+step=$(hash_of packages/*/pyproject.toml)
+if [ "$(cat "$STAMPS/packages" 2>/dev/null)" != "$step" ]; then
+  log "installing the EasyNav packages (editable)"
+  args=()
+  for pkg in packages/*/; do
+    name=$(basename "$pkg")
+    [ "$name" = easynav-interfaces ] && continue
+    args+=(-e "$pkg")
+  done
+  "${PIP[@]}" --no-build-isolation "${args[@]}"
+  echo "$step" > "$STAMPS/packages"
+fi
+log "environment ready: $VENV"
