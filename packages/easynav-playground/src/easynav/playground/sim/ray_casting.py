@@ -46,7 +46,7 @@ def cast_rays_grid(
     t_end = np.minimum(t[:, 1:], reach)
     # A segment between consecutive crossings lies in exactly one cell: sample its midpoint.
     valid = t_end > t_start
-    mid = 0.5 * (t_start + t_end)
+    mid = np.where(valid, 0.5 * (t_start + t_end), 0.0)  # inf segments: any finite value
     cx = np.floor(gx + mid * dx[:, None]).astype(np.int64)
     cy = np.floor(gy + mid * dy[:, None]).astype(np.int64)
     inside = valid & (cx >= 0) & (cy >= 0) & (cx < width) & (cy < height)

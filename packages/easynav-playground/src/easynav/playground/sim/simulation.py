@@ -75,8 +75,8 @@ class Simulation:
         self._command_lock = threading.Lock()
         self._pending_command: tuple[float, float] | None = None
         self.commands_received = 0
-        self._next_scan = 0.0
-        self._next_odom = 0.0
+        self._next_scan = scanner.period
+        self._next_odom = self.odom_period
         what = self.checker.colliding_with(robot.x, robot.y, self.obstacles)
         if what is not None:
             raise ValueError(
@@ -141,7 +141,7 @@ class Simulation:
         self.steps += 1
         self.time = self.steps * dt
         stamp = self.time
-        collision = self.checker.record(stamp, robot.x, robot.y, what)
+        collision = self.checker.record(stamp, robot.x, robot.y, what, self.obstacles)
         if collision is not None:
             self.recorder.record_collision(collision.as_dict())
             for cb in self.on_collision:

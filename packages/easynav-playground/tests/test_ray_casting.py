@@ -1,0 +1,85 @@
+"""Ray casting against the grid and discs, checked against a brute-force ray march."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from easynav.playground.sim import World, cast_rays_discs, cast_rays_grid
+
+MARCH_STEP = 0.0002
+
+
+def march(world, x, y, angles, max_range, discs=()):
+    """Reference: walk each ray in tiny steps and stop at the first occupied point."""
+    t = np.arange(0.0, max_range, MARCH_STEP)
+    px = x + np.cos(angles)[:, None] * t
+    py = y + np.sin(angles)[:, None] * t
+    hit = world.is_occupied_at(px, py)
+    for (cx, cy), r in discs:
+        hit |= np.hypot(px - cx, py - cy) <= r
+    return np.where(hit.any(axis=1), t[np.argmax(hit, axis=1)], np.inf)
+
+
+@pytest.fixture(scope="module")
+def sandbox():
+    return World.load("/work/shared/maps/tb3_sandbox.yaml")
+
+
+def test_grid_ray_cast_matches_brute_force_on_a_real_map(sandbox):
+    rng = np.random.default_rng(7)
+    free = np.argwhere(~sandbox.occupied)
+    for _ in range(15):
+        iy, ix = free[rng.integers(len(free))]
+        x, y = sandbox.cell_centre(ix, iy)
+        x += rng.uniform(-0.02, 0.02)
+        y += rng.uniform(-0.02, 0.02)
+        angles = rng.uniform(-math.pi, math.pi, 64)
+        fast = cast_rays_grid(sandbox, x, y, angles, 4.0)
+        slow = march(sandbox, x, y, angles, 4.0)
+        assert np.array_equal(np.isinf(fast), np.isinf(slow))
+        finite = np.isfinite(fast)
+        assert np.max(np.abs(fast[finite] - slow[finite]), initial=0.0) <= MARCH_STEP + 1e-9
+
+
+def test_axis_aligned_rays_hit_the_wall_face_exactly():
+    grid = np.zeros((20, 20), dtype=bool)
+    grid[:, 15] = True  # wall whose west face is x = 1.5
+    world = World(grid, 0.1)
+    d = cast_rays_grid(world, 0.52, 1.0, np.array([0.0, math.pi, math.pi / 2]), 5.0)
+    assert d[0] == pytest.approx(1.5 - 0.52)
+    assert d[1] == np.inf and d[2] == np.inf  # leaves the grid: no return
+
+
+def test_ray_from_outside_the_grid_still_finds_it():
+    grid = np.zeros((10, 10), dtype=bool)
+    grid[5, 5] = True
+    world = World(grid, 0.1, 0.0, 0.0)
+    d = cast_rays_grid(world, -3.0, 0.55, np.array([0.0]), 10.0)
+    assert d[0] == pytest.approx(3.5)
+
+
+def test_max_range_cuts_returns(sandbox):
+    d = cast_rays_grid(sandbox, 0.0, 0.5, np.linspace(-math.pi, math.pi, 90), 0.3)
+    assert np.all(np.isinf(d) | (d <= 0.3))
+
+
+def test_disc_ray_cast_matches_brute_force():
+    world = World(np.zeros((1, 1), dtype=bool), 0.01, -100.0, -100.0)
+    discs = [((1.0, 0.2), 0.3), ((-0.5, -1.0), 0.25)]
+    angles = np.linspace(-math.pi, math.pi, 200, endpoint=False)
+    fast = cast_rays_discs(0.0, 0.0, angles, [c for c, _ in discs], [r for _, r in discs])
+    slow = march(world, 0.0, 0.0, angles, 3.0, discs)
+    assert np.array_equal(np.isinf(fast), np.isinf(slow))
+    finite = np.isfinite(fast)
+    assert finite.sum() > 10
+    assert np.max(np.abs(fast[finite] - slow[finite])) <= MARCH_STEP + 1e-9
+
+
+def test_ray_starting_inside_a_disc_has_zero_range_and_discs_behind_are_ignored():
+    d = cast_rays_discs(0.0, 0.0, np.array([0.0, math.pi]), [(0.0, 0.0)], [0.5])
+    assert d.tolist() == [0.0, 0.0]
+    d = cast_rays_discs(0.0, 0.0, np.array([0.0]), [(-2.0, 0.0)], [0.5])
+    assert d[0] == np.inf
