@@ -1,0 +1,355 @@
+"""PlaygroundNode: the simulated robot as a ROS 2 node (a driver, a laser and /clock)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+from geometry_msgs.msg import Twist, TwistStamped
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import String
+
+from easynav.core.tf import StaticTFBroadcaster, TFBroadcaster
+from easynav.playground.fixed_rate_loop import FixedRateLoop
+from easynav.playground.ros import messages
+from easynav.playground.sim import (
+    BaseLimits,
+    Collision,
+    DiffDriveRobot,
+    LaserScanner,
+    Simulation,
+    WheelOdometry,
+)
+from easynav.playground.world_description import WorldDescription
+
+#: Parameters of the node and their defaults (see the README's parameter table).
+DEFAULT_PARAMETERS: dict[str, object] = {
+    "world": "home",
+    "speed_up": 1.0,
+    "seed": 0,
+    "step": 0.005,
+    "start_pose": [math.nan, math.nan, math.nan],
+    "robot_radius": 0.2,
+    "cmd_timeout": 0.0,
+    "odom_rate": 50.0,
+    "moving_obstacles": True,
+    "record": "",
+    "map_frame": "map",
+    "odom_frame": "odom",
+    "robot_footprint_frame": "base_footprint",
+    "robot_frame": "base_link",
+    "laser_frame": "base_laser",
+    "base_link_height": 0.05,
+    "laser.beams": 360,
+    "laser.fov": 2.0 * math.pi,
+    "laser.min_range": 0.12,
+    "laser.max_range": 10.0,
+    "laser.rate": 10.0,
+    "laser.noise_std": 0.01,
+    "laser.x": 0.1,
+    "laser.y": 0.0,
+    "laser.z": 0.25,
+    "laser.yaw": 0.0,
+    "odometry.linear_scale": 1.01,
+    "odometry.angular_scale": 0.99,
+    "odometry.linear_noise": 0.01,
+    "odometry.angular_noise": 0.02,
+    "odometry.drift_per_metre": 0.01,
+    "base.max_linear_vel": 0.7,
+    "base.max_angular_vel": 3.0,
+    "base.max_linear_acc": 1.5,
+    "base.max_linear_decel": 3.0,
+    "base.max_angular_acc": 6.0,
+    "base.max_angular_decel": 8.0,
+}
+
+_RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+_LATCHED = QoSProfile(
+    depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+
+
+class PlaygroundNode(Node):
+    """The playground robot: runs a :class:`Simulation` in simulated time and talks ROS.
+
+    Publishes ``/clock`` (every step), ``scan`` (``laser.rate``), ``odom`` and the ``odom ->
+    base_footprint`` transform on ``tf`` (``odom_rate``), ``ground_truth`` (true pose in the map
+    frame, same rate), the static ``base_footprint -> base_link -> base_laser`` transforms on
+    ``tf_static``, ``collisions`` (latched JSON: count and the last collision) and the world on
+    ``playground/world`` (latched OccupancyGrid). Subscribes ``cmd_vel`` (Twist) and
+    ``cmd_vel_stamped`` (TwistStamped). It publishes /clock; it does not use it.
+
+    Thread contract: construct, :meth:`start` and :meth:`stop` from the main thread. Command
+    callbacks run in the executor thread and only hand the command to the simulation (under
+    its lock); the simulation loop thread steps and publishes.
+
+    Raises:
+        ValueError: a bad parameter (names it), or a start pose in collision.
+        FileNotFoundError: an unknown world.
+    """
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__("playground", **kwargs)
+        for name, default in DEFAULT_PARAMETERS.items():
+            if not self.has_parameter(name):
+                self.declare_parameter(name, default)
+        p = self._param
+        self.description = WorldDescription.resolve(str(p("world")))
+        speed_up = float(p("speed_up"))
+        if not (math.isfinite(speed_up) and speed_up > 0.0):
+            raise ValueError(f"playground: speed_up must be finite and > 0, got {speed_up}")
+        self.speed_up = speed_up
+        seed = int(p("seed"))
+        start = [float(v) for v in p("start_pose")]
+        if len(start) != 3:
+            raise ValueError(f"playground: start_pose must be [x, y, yaw], got {start}")
+        if any(math.isnan(v) for v in start):
+            start = list(self.description.start_pose)
+        self.start_pose = tuple(start)
+        rng_scan, rng_odom = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)
+        )
+        limits = BaseLimits(**{k: float(p(f"base.{k}")) for k in BaseLimits.__slots__})
+        robot = DiffDriveRobot(*self.start_pose, limits=limits, cmd_timeout=float(p("cmd_timeout")))
+        self.scanner = LaserScanner(
+            beams=int(p("laser.beams")),
+            fov=float(p("laser.fov")),
+            min_range=float(p("laser.min_range")),
+            max_range=float(p("laser.max_range")),
+            rate=float(p("laser.rate")),
+            range_noise_std=float(p("laser.noise_std")),
+            rng=rng_scan,
+        )
+        odometry = WheelOdometry(
+            linear_scale=float(p("odometry.linear_scale")),
+            angular_scale=float(p("odometry.angular_scale")),
+            linear_noise=float(p("odometry.linear_noise")),
+            angular_noise=float(p("odometry.angular_noise")),
+            drift_per_metre=float(p("odometry.drift_per_metre")),
+            rng=rng_odom,
+        )
+        obstacles = self.description.make_obstacles() if p("moving_obstacles") else []
+        self.sim = Simulation(
+            self.description.world,
+            robot,
+            self.scanner,
+            odometry,
+            obstacles=obstacles,
+            robot_radius=float(p("robot_radius")),
+            step=float(p("step")),
+            odom_rate=float(p("odom_rate")),
+            laser_offset=(float(p("laser.x")), float(p("laser.y")), float(p("laser.yaw"))),
+        )
+        self.record_path = str(p("record"))
+        self.frames = {
+            k: str(p(k))
+            for k in (
+                "map_frame",
+                "odom_frame",
+                "robot_footprint_frame",
+                "robot_frame",
+                "laser_frame",
+            )
+        }
+        self._base_link_height = float(p("base_link_height"))
+        self._laser_z = float(p("laser.z"))
+
+        self._clock_pub = self.create_publisher(Clock, "/clock", _RELIABLE)
+        self._scan_pub = self.create_publisher(messages.LaserScan, "scan", _RELIABLE)
+        self._odom_pub = self.create_publisher(messages.Odometry, "odom", _RELIABLE)
+        self._truth_pub = self.create_publisher(messages.Odometry, "ground_truth", _RELIABLE)
+        self._collisions_pub = self.create_publisher(String, "collisions", _LATCHED)
+        self._world_pub = self.create_publisher(
+            messages.OccupancyGrid, "playground/world", _LATCHED
+        )
+        self._tf = TFBroadcaster(self)
+        self._tf_static = StaticTFBroadcaster(self)
+        self.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, _RELIABLE)
+        self.create_subscription(
+            TwistStamped, "cmd_vel_stamped", self._on_cmd_vel_stamped, _RELIABLE
+        )
+        self._warned_lateral = False
+        self._rejected_commands = 0
+
+        self.sim.on_scan.append(self._publish_scan)
+        self.sim.on_odometry.append(self._publish_odometry)
+        self.sim.on_collision.append(self._publish_collision)
+        self._loop = FixedRateLoop(
+            self.sim.step_size / self.speed_up, self._tick, max_lag=0.25, name="playground-sim"
+        )
+
+    def _param(self, name: str):
+        return self.get_parameter(name).value
+
+    # ------------------------------------------------------------------ lifecycle
+    def start(self) -> None:
+        """Publish the latched and static data, then start the simulation loop thread."""
+        f = self.frames
+        self._tf_static.send_transform(
+            [
+                messages.planar_transform_msg(
+                    0.0,
+                    f["robot_footprint_frame"],
+                    f["robot_frame"],
+                    0.0,
+                    0.0,
+                    self._base_link_height,
+                ),
+                messages.planar_transform_msg(
+                    0.0,
+                    f["robot_frame"],
+                    f["laser_frame"],
+                    self.sim.laser_offset[0],
+                    self.sim.laser_offset[1],
+                    self._laser_z - self._base_link_height,
+                    self.sim.laser_offset[2],
+                ),
+            ]
+        )
+        self._world_pub.publish(
+            messages.occupancy_grid_msg(self.description.world, 0.0, f["map_frame"])
+        )
+        self._collisions_pub.publish(String(data=json.dumps({"count": 0, "last": None})))
+        x, y, yaw = self.start_pose
+        self.get_logger().info(
+            f"world '{self.description.world.name}' ({self.description.source or 'built in'}), "
+            f"start ({x:.2f}, {y:.2f}, {yaw:.2f}), step {self.sim.step_size * 1000:.1f} ms, "
+            f"speed-up x{self.speed_up:g}, {len(self.sim.obstacles)} moving obstacle(s)"
+        )
+        self._loop.start()
+
+    def stop(self) -> None:
+        """Stop the simulation loop and write the record file when one was asked for.
+
+        Raises:
+            BaseException: what stopped the simulation loop, if it failed.
+        """
+        try:
+            self._loop.stop()
+        finally:
+            if self.record_path:
+                self.write_record(self.record_path)
+
+    def write_record(self, path: str | Path) -> None:
+        """Save the ground truth (trajectory, clearances, collisions) and run statistics."""
+        rec = self.sim.recorder
+        data = rec.to_dict()
+        data["sim_time"] = self.sim.time
+        data["wall_time"] = self._loop.elapsed()
+        data["commands_received"] = self.sim.commands_received
+        data["commands_rejected"] = self._rejected_commands
+        data["start_pose"] = list(self.start_pose)
+        data["world"] = self.description.world.name
+        tmp = Path(path).with_name(Path(path).name + ".tmp")
+        tmp.write_text(json.dumps(data))
+        tmp.replace(path)
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated seconds per wall second achieved so far."""
+        wall = self._loop.elapsed()
+        return self.sim.time / wall if wall > 0 else 0.0
+
+    @property
+    def loop_running(self) -> bool:
+        """False once the simulation loop stopped (after :meth:`stop` or on an error)."""
+        return self._loop.running
+
+    # ------------------------------------------------------------------ simulation thread
+    def _tick(self) -> None:
+        self.sim.step()
+        clock = Clock()
+        clock.clock = messages.stamp_msg(self.sim.time)
+        self._clock_pub.publish(clock)
+
+    def _publish_scan(self, stamp: float, ranges: np.ndarray) -> None:
+        self._scan_pub.publish(
+            messages.laser_scan_msg(self.scanner, ranges, stamp, self.frames["laser_frame"])
+        )
+
+    def _publish_odometry(self, stamp: float) -> None:
+        f = self.frames
+        odom = self.sim.odometry
+        self._odom_pub.publish(
+            messages.planar_odometry_msg(
+                stamp,
+                f["odom_frame"],
+                f["robot_footprint_frame"],
+                (odom.x, odom.y, odom.yaw),
+                (odom.v, odom.w),
+                pose_variance=(0.01, 0.01),
+            )
+        )
+        self._tf.send_transform(
+            messages.planar_transform_msg(
+                stamp, f["odom_frame"], f["robot_footprint_frame"], odom.x, odom.y, 0.0, odom.yaw
+            )
+        )
+        robot = self.sim.robot
+        self._truth_pub.publish(
+            messages.planar_odometry_msg(
+                stamp,
+                f["map_frame"],
+                f["robot_footprint_frame"],
+                (robot.x, robot.y, robot.yaw),
+                (robot.v, robot.w),
+            )
+        )
+
+    def _publish_collision(self, collision: Collision) -> None:
+        count = len(self.sim.checker.collisions)
+        self.get_logger().warning(
+            f"collision #{count} with {collision.with_what} at ({collision.x:.2f}, "
+            f"{collision.y:.2f}), t={collision.stamp:.2f} s"
+        )
+        self._collisions_pub.publish(
+            String(data=json.dumps({"count": count, "last": collision.as_dict()}))
+        )
+
+    # ------------------------------------------------------------------ executor thread
+    def _on_cmd_vel(self, msg: Twist) -> None:
+        self._command(msg)
+
+    def _on_cmd_vel_stamped(self, msg: TwistStamped) -> None:
+        self._command(msg.twist)
+
+    def _command(self, twist: Twist) -> None:
+        lin, ang = twist.linear, twist.angular
+        if not self._warned_lateral and (lin.y or lin.z or ang.x or ang.y):
+            self._warned_lateral = True
+            self.get_logger().warning(
+                f"cmd_vel with linear.y={lin.y}, linear.z={lin.z}, angular.x={ang.x}, "
+                f"angular.y={ang.y}: a differential drive only executes linear.x and angular.z"
+                " (warned once)"
+            )
+        try:
+            self.sim.set_command(lin.x, ang.z)
+        except ValueError as err:
+            # A driver must not keep moving on garbage: stop and say why.
+            self._rejected_commands += 1
+            self.sim.set_command(0.0, 0.0)
+            self.get_logger().error(f"rejected cmd_vel, stopping the base: {err}")
+
+
+def parameter_overrides(values: dict[str, object]) -> list[Parameter]:
+    """rclpy Parameters for :class:`PlaygroundNode` from plain values (CLI options).
+
+    Raises:
+        KeyError: a name that is not a playground parameter.
+    """
+    result = []
+    for name, value in values.items():
+        if name not in DEFAULT_PARAMETERS:
+            raise KeyError(f"unknown playground parameter {name!r}")
+        default = DEFAULT_PARAMETERS[name]
+        if isinstance(default, float) and isinstance(value, int):
+            value = float(value)
+        if isinstance(default, list):
+            value = [float(v) for v in value]
+        result.append(Parameter(name, value=value))
+    return result
