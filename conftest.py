@@ -4,4 +4,7 @@ from easynav.core.testing.dds_isolation import isolate_dds
 
 isolate_dds()
 
-pytest_plugins = ["easynav.core.testing.ros_fixtures"]
+pytest_plugins = [
+    "easynav.core.testing.ros_fixtures",
+    "easynav.core.testing.system_fixtures",
+]

@@ -65,7 +65,18 @@ def not_found_message(kind: PluginKind, name: str, parameter: str) -> str:
     message = f"{parameter}: unknown {kind.name} plugin '{name}'."
     provider = CATALOGUE.get(name)
     if provider:
-        message += f" It is provided by the '{provider}' distribution: pip install {provider}."
+        try:
+            installed_version = metadata.version(provider)
+        except metadata.PackageNotFoundError:
+            message += (
+                f" It is provided by the '{provider}' distribution, which is not installed: "
+                f"pip install {provider}."
+            )
+        else:
+            message += (
+                f" It belongs to the '{provider}' distribution, but the installed "
+                f"{provider} {installed_version} does not provide it."
+            )
     else:
         other = [k.name for k in ALL_KINDS if k is not kind and plugin_exists(k, name)]
         if other:

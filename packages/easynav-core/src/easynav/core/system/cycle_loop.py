@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-import os
 import threading
 import time
 from collections.abc import Callable
 
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+
+from easynav.core.safety.realtime import set_thread_realtime
 
 
 class CycleLoop(threading.Thread):
@@ -61,18 +62,9 @@ class CycleLoop(threading.Thread):
     def _become_realtime(self) -> None:
         if not self.realtime:
             return
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(self.priority))
-            ok, message = True, f"{self.name}: SCHED_FIFO priority {self.priority}"
-        except (PermissionError, OSError) as exc:
-            ok = False
-            message = (
-                f"{self.name}: SCHED_FIFO priority {self.priority} not permitted ({exc}); running "
-                f"at normal priority. Grant RLIMIT_RTPRIO >= {self.priority} (limits.d rtprio, "
-                f"systemd LimitRTPRIO, docker --ulimit rtprio) or set use_real_time: false"
-            )
+        ok, message = set_thread_realtime(self.priority)
         if self.on_realtime_result is not None:
-            self.on_realtime_result(ok, message)
+            self.on_realtime_result(ok, f"{self.name}: {message}")
 
     def _run_cycle(self, triggered: bool) -> None:
         try:

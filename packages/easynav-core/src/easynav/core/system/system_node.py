@@ -13,6 +13,7 @@ from std_msgs.msg import String
 from easynav.core.robot import RobotGeometry, RobotGeometryRegistry
 from easynav.core.system.component_node import ComponentNode
 from easynav.core.system.controller_node import ControllerNode
+from easynav.core.system.goal_manager_extension import GoalManagerExtension
 from easynav.core.system.localizer_node import LocalizerNode
 from easynav.core.system.maps_manager_node import MapsManagerNode
 from easynav.core.system.node_parameters import NodeParameters
@@ -104,6 +105,8 @@ class SystemNode(LifecycleNode):
         }
         self.navstate_publisher = self.create_publisher(String, "easynav_navstate", 1)
         self.extensions: list[Any] = []  # goal manager, safety supervisor: see add_extension
+        self.goal_manager = GoalManagerExtension(self)
+        self.add_extension(self.goal_manager)
 
     def _ns_key(self) -> str:
         return self.get_namespace().strip("/")
@@ -114,6 +117,10 @@ class SystemNode(LifecycleNode):
 
     def lifecycle_state(self) -> str:
         return self._state_machine.current_state[1]
+
+    def now_seconds(self) -> float:
+        """system_node's clock in seconds (simulated time with use_sim_time)."""
+        return self.get_clock().now().nanoseconds * 1e-9
 
     # -- extensions -----------------------------------------------------------------------------
     def add_extension(self, extension: Any) -> None:

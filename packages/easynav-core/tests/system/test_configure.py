@@ -1,0 +1,152 @@
+"""Configuring the system: all or nothing, with errors that name the parameter or package."""
+
+from __future__ import annotations
+
+import pytest
+
+from easynav.core.testing.system_fixtures import system_params, wait_for
+from easynav.core.types import DiagnosticLevel
+
+pytestmark = pytest.mark.ros
+
+
+def _states(runtime) -> dict[str, str]:
+    node = runtime.system_node
+    return {name: n.lifecycle_state() for name, n in node.subnodes.items()} | {
+        "system_node": node.lifecycle_state()
+    }
+
+
+def test_dummy_system_configures_and_activates(params_file, runtime_factory):
+    rt = runtime_factory(params_file(system_params()))
+    assert rt.start(), rt.error
+    assert set(_states(rt).values()) == {"active"}
+    plugins = rt.system_node.loaded_plugins()
+    assert plugins["controller_node"] == [("dummy", "easynav_controller/DummyController")]
+    assert plugins["recovery_node"] == [
+        ("recovery_manager", "easynav_recovery/DummyRecoveryManager")
+    ]
+
+
+def test_recovery_manager_defaults_to_the_dummy_one(params_file, runtime_factory):
+    document = system_params(**{"recovery_node.recovery_manager": None})
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    assert rt.system_node.loaded_plugins()["recovery_node"] == [
+        ("recovery_manager", "easynav_recovery/DummyRecoveryManager")
+    ]
+
+
+def test_component_faster_than_its_system_cycle_fails_naming_the_parameter(
+    params_file, runtime_factory
+):
+    document = system_params(**{"controller_node.dummy.rt_freq": 300.0})
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "dummy.rt_freq" in rt.error and "system_node.rt_freq" in rt.error
+    # All or nothing: every node is left unconfigured.
+    assert set(_states(rt).values()) == {"unconfigured"}
+
+
+def test_non_rt_frequency_checked_against_system_freq(params_file, runtime_factory):
+    document = system_params(**{"system_node.freq": 20.0, "maps_manager_node.dummy.freq": 50.0})
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "dummy.freq" in rt.error and "system_node.freq" in rt.error
+
+
+@pytest.mark.parametrize("value", [0.0, -5.0, float("nan"), float("inf")])
+def test_frequency_must_be_finite_and_positive(params_file, runtime_factory, value):
+    document = system_params(**{"planner_node.dummy.freq": value})
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "dummy.freq" in rt.error
+
+
+def test_failed_planner_leaves_every_node_unconfigured(params_file, runtime_factory):
+    document = system_params(**{"planner_node.dummy.plugin": "easynav_planner/NoSuchPlanner"})
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "planner_node.dummy.plugin" in rt.error
+    assert "easynav_planner/DummyPlanner" in rt.error  # lists what is installed
+    assert set(_states(rt).values()) == {"unconfigured"}
+
+
+def test_plugin_of_a_package_not_installed_names_the_package(
+    params_file, runtime_factory, monkeypatch
+):
+    from easynav.core.plugins import catalogue
+
+    monkeypatch.setitem(
+        catalogue.CATALOGUE, "easynav_fancy_controller/FancyController", "easynav-fancy"
+    )
+    document = system_params(
+        **{"controller_node.dummy.plugin": "easynav_fancy_controller/FancyController"}
+    )
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "easynav-fancy" in rt.error and "pip install easynav-fancy" in rt.error
+
+
+def test_more_than_one_controller_is_refused(params_file, runtime_factory):
+    document = system_params(
+        **{
+            "controller_node.controller_types": ["a", "b"],
+            "controller_node.a": {"plugin": "easynav_controller/DummyController"},
+            "controller_node.b": {"plugin": "easynav_controller/DummyController"},
+        }
+    )
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "controller_node.controller_types" in rt.error
+
+
+def test_alias_without_plugin_name_is_named(params_file, runtime_factory):
+    document = system_params(**{"localizer_node.dummy.plugin": None})
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "localizer_node.dummy.plugin is not set" in rt.error
+
+
+def test_wrongly_typed_parameter_is_named(params_file, runtime_factory):
+    document = system_params(**{"system_node.rt_freq": "fast"})
+    rt = runtime_factory(params_file(document))
+    assert not rt.start()
+    assert "rt_freq" in rt.error
+
+
+def test_integer_frequencies_are_accepted(params_file, runtime_factory):
+    document = system_params(**{"controller_node.dummy.rt_freq": 30})
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+
+
+def test_slow_rt_component_makes_its_rate_diagnostic_warn(params_file, runtime_factory):
+    # A 30 Hz controller whose update busy-waits 60 ms cannot run more than ~16 times a second.
+    document = system_params(**{"controller_node.dummy.cycle_time_rt": 0.06})
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    key = "diagnostics.controller_node.dummy.rt_rate"
+
+    def warned():
+        return rt.nav_state.has(key) and rt.nav_state.get(key).level == DiagnosticLevel.WARN
+
+    assert wait_for(warned, timeout=6.0)
+    status = rt.nav_state.get(key)
+    assert "dummy.rt_freq" in status.message
+    # Only ever a WARN: the other components are not reported.
+    other = rt.nav_state.get("diagnostics.planner_node.dummy.rate")
+    assert other.level == DiagnosticLevel.OK
+
+
+def test_unique_aliases_keep_the_plain_diagnostic_name(params_file, runtime_factory):
+    document = system_params(
+        **{
+            "controller_node.controller_types": ["ctrl"],
+            "controller_node.dummy": None,
+            "controller_node.ctrl": {"plugin": "easynav_controller/DummyController"},
+        }
+    )
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    assert wait_for(lambda: rt.nav_state.has("diagnostics.ctrl.rt_rate"))
