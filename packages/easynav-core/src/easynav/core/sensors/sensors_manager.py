@@ -86,7 +86,7 @@ class SensorsManager:
         without the node prefix). ``node`` None (tests, tools) subscribes and publishes nothing;
         feed messages with :meth:`handle_message`. ``clock`` returns ROS time in seconds
         (default: ``node``'s clock, simulated with ``use_sim_time``). ``tf_buffer`` defaults to
-        the process-wide :func:`~easynav.core.tf.get_tf_buffer`.
+        :func:`~easynav.core.tf.get_tf_buffer` of ``node``'s namespace (as system_node's).
         """
         self.cleanup()
         self._node = node
@@ -101,6 +101,8 @@ class SensorsManager:
             self._clock = lambda: ros_clock.now().nanoseconds * 1e-9
         else:
             raise SensorsConfigurationError("SensorsManager.configure needs a node or a clock")
+        if tf_buffer is None:
+            tf_buffer = get_tf_buffer(node.get_namespace()) if node is not None else get_tf_buffer()
         self._tf_buffer = tf_buffer
         self._forget_time = self._read_forget_time(params)
         sensor_ids = self._read_sensor_ids(params)

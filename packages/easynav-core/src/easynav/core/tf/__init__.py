@@ -15,7 +15,11 @@ from easynav.core.tf.errors import (
 from easynav.core.tf.static_tf_broadcaster import StaticTFBroadcaster
 from easynav.core.tf.tf_broadcaster import TFBroadcaster
 from easynav.core.tf.tf_buffer import TFBuffer
-from easynav.core.tf.tf_buffer_registry import get_tf_buffer, reset_tf_buffers
+from easynav.core.tf.tf_buffer_registry import (
+    get_tf_buffer,
+    reset_tf_buffers,
+    set_default_tf_namespace,
+)
 from easynav.core.tf.tf_info import TFInfo
 from easynav.core.tf.tf_listener import TFListener
 
@@ -31,4 +35,5 @@ __all__ = [
     "TransformError",
     "get_tf_buffer",
     "reset_tf_buffers",
+    "set_default_tf_namespace",
 ]

@@ -70,6 +70,7 @@ class TFBuffer:
         self._parents: set[str] = set()  # frames seen only as parents are valid frames too
         self._chains: dict[tuple[str, str], tuple[tuple[FrameHistory, ...], ...]] = {}
         self._tf_info = TFInfo()
+        self._has_tf_info = False
         self._logger = logger if logger is not None else logging.getLogger("easynav.tf")
         self._last_warning: dict[tuple[str, str, str], float] = {}
 
@@ -97,6 +98,12 @@ class TFBuffer:
             raise TypeError(f"set_tf_info expects a TFInfo, got {type(tf_info).__name__}")
         with self._lock:
             self._tf_info = tf_info
+            self._has_tf_info = True
+
+    @property
+    def has_tf_info(self) -> bool:
+        """True once :meth:`set_tf_info` was called (else :meth:`get_tf_info` gives defaults)."""
+        return self._has_tf_info
 
     def get_tf_info(self) -> TFInfo:
         """The robot's frame names, prefix applied (an immutable snapshot)."""

@@ -32,7 +32,7 @@ class TFListener:
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from tf2_msgs.msg import TFMessage
 
-        self.buffer = buffer if buffer is not None else get_tf_buffer()
+        self.buffer = buffer if buffer is not None else get_tf_buffer(node.get_namespace())
         self._node = node
         dynamic_qos = QoSProfile(
             depth=100,
