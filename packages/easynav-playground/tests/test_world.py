@@ -131,3 +131,29 @@ def test_resolve_accepts_names_map_files_and_map_server_yaml(tmp_path):
     assert sandbox.world.width == 384
     with pytest.raises(FileNotFoundError, match="shipped"):
         WorldDescription.resolve("atlantis")
+
+
+@pytest.mark.parametrize("name", sorted(BUILTIN_WORLDS))
+def test_shipped_waypoints_are_reachable_by_simple_planner_rules(name):
+    from easynav.playground.reachability import reachable_from
+    from easynav.playground.world_description import load_waypoints
+
+    description = WorldDescription.resolve(name)
+    waypoints = load_waypoints(description.waypoints_path)
+    assert len(waypoints) >= 3
+    # 0.2 m planning grid, 0.3 m robot radius + 0.2 m clearance; each leg from the last stop.
+    starts = [description.start_pose[:2]] + [w[:2] for w in waypoints[:-1]]
+    for start, target in zip(starts, waypoints, strict=True):
+        assert reachable_from(description.world, start, [target[:2]]) == [True], (start, target)
+
+
+def test_reachability_sees_a_door_too_narrow_for_the_clearance():
+    grid = np.zeros((80, 80), dtype=bool)  # 4 x 4 m at 0.05
+    grid[:, 40:42] = True  # a wall at x = 2.0 with a door
+    grid[36:48, 40:42] = False  # 0.6 m wide: the robot fits, the clearance does not
+    world = World(grid, 0.05)
+    from easynav.playground.reachability import reachable_from
+
+    assert reachable_from(world, (1.0, 2.0), [(1.0, 3.0), (3.0, 2.0)]) == [True, False]
+    grid[30:54, 40:42] = False  # 1.2 m on the 0.2 m grid
+    assert reachable_from(World(grid, 0.05), (1.0, 2.0), [(3.0, 2.0)]) == [True]
