@@ -1,0 +1,194 @@
+"""SimplePlanner (easynav_simple_planner/SimplePlanner): A* on the simple binary map."""
+
+from __future__ import annotations
+
+import math
+
+from easynav.core.diagnostics import write_diagnostic
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import PlannerMethodBase, PluginConfigurationError
+from easynav.core.robot import RobotGeometry
+from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Goals, Header, Odometry, Path
+from easynav.maps import SimpleMap
+from easynav.planners.simple_grid_planner import SimpleGridPlanner
+
+#: NavState keys.
+MAP_KEY = "map"
+PATH_KEY = "path"
+#: The planner's diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
+DIAGNOSTIC_NAME = "path"
+HARDWARE_ID = "planner"
+
+
+class SimplePlanner(PlannerMethodBase):
+    """Plans to the first goal with :class:`SimpleGridPlanner` on NavState ``map``.
+
+    Parameters (under ``<alias>.``): ``clearance_distance`` (0.2 m), ``robot_radius``
+    (deprecated: ``system_node.robot_geometry.radius`` is used unless this is set; set, it
+    applies with a warning only where robot_geometry keeps its default radius), ``smooth_path``
+    (True: line-of-sight shortcuts; False: the raw 8-connected cell path, as the original).
+
+    NavState: reads ``goals`` (:class:`Goals`, plans to the first), ``robot_pose``
+    (:class:`Odometry`), ``map`` (:class:`SimpleMap`, with live obstacles); writes ``path``
+    (:class:`Path` in the map frame; empty when there is no goal or no path) and
+    ``diagnostics.path`` (hardware id ``planner``: OK with the path length, WARN naming the goal
+    and the reason when there is no path), written when it changes.
+
+    A goal must be in the map frame (an empty frame id counts as the map frame); the path stamp
+    is the newer of the robot pose's and the goal's.
+
+    ROS (when hosted by a node): publishes ``<fqn>/<alias>/path`` (nav_msgs/Path) while
+    subscribed.
+
+    Thread contract: ``initialize`` in the configuring thread, ``update`` in the non-RT thread.
+    Exceptions: :class:`PluginConfigurationError` naming the parameter; ``update`` does not raise
+    for unreachable goals (it reports them).
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.planner = SimpleGridPlanner()
+        self._throttle = WarningThrottle(period=5.0)
+        self._last_status: tuple[int, str] | None = None
+        self._publisher = None
+
+    def on_initialize(self) -> None:
+        self._destroy_publisher()
+        alias = self.plugin_name
+        clearance = self._distance("clearance_distance", 0.2)
+        radius = self._robot_radius()
+        smooth = self.get_parameter("smooth_path", True, "shorten the A* path by line of sight")
+        try:
+            self.planner = SimpleGridPlanner(radius, clearance, smooth=bool(smooth))
+        except ValueError as exc:
+            raise PluginConfigurationError(f"{alias}: {exc}") from None
+        self._last_status = None
+        node = self.context.node
+        if node is not None:
+            from nav_msgs.msg import Path as PathMsg
+
+            topic = f"{node.get_fully_qualified_name().rstrip('/')}/{alias}/path"
+            self._publisher = node.create_publisher(PathMsg, topic, 10)
+
+    def on_cleanup(self) -> None:
+        self._destroy_publisher()
+
+    def _destroy_publisher(self) -> None:
+        if self._publisher is not None and self.context.node is not None:
+            self.context.node.destroy_publisher(self._publisher)
+        self._publisher = None
+
+    def _distance(self, name: str, default: float) -> float:
+        value = self.get_parameter(name, default)
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise PluginConfigurationError(
+                f"{self.plugin_name}.{name} = {value!r} is not a number"
+            ) from None
+        if not math.isfinite(value) or value < 0.0:
+            raise PluginConfigurationError(
+                f"{self.plugin_name}.{name} = {value} must be finite and >= 0"
+            )
+        return value
+
+    def _robot_radius(self) -> float:
+        geometry = self.get_robot_geometry()
+        # NaN means "not set": the deprecated parameter only counts when a user sets it.
+        legacy = self._distance_or_nan("robot_radius")
+        if math.isnan(legacy):
+            return geometry.radius
+        name = f"{self.plugin_name}.robot_radius"
+        if geometry.radius != RobotGeometry().radius:
+            self.logger.warning(
+                f"{name} is deprecated and ignored: system_node.robot_geometry.radius = "
+                f"{geometry.radius:g} takes precedence"
+            )
+            return geometry.radius
+        self.logger.warning(
+            f"{name} = {legacy:g} is deprecated: set system_node.robot_geometry.radius instead"
+        )
+        return legacy
+
+    def _distance_or_nan(self, name: str) -> float:
+        value = self.get_parameter(name, math.nan, "deprecated: robot_geometry.radius")
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise PluginConfigurationError(
+                f"{self.plugin_name}.{name} = {value!r} is not a number"
+            ) from None
+        if math.isnan(value):
+            return value
+        if not math.isfinite(value) or value < 0.0:
+            raise PluginConfigurationError(
+                f"{self.plugin_name}.{name} = {value} must be finite and >= 0"
+            )
+        return value
+
+    # -- update -------------------------------------------------------------------------------
+    def update(self, nav_state: NavState) -> None:
+        """Plan to the first goal and write ``path``. Non-RT thread."""
+        if not nav_state.has("goals"):
+            return
+        map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
+        goals = nav_state.get("goals", Goals)
+        if len(goals) == 0:
+            self._write(nav_state, Path(Header(self.now(), map_frame)), None, "idle: no goal")
+            return
+        goal = goals.goals[0]
+        gx, gy, gyaw = goal.pose.x, goal.pose.y, goal.pose.yaw
+        goal_text = f"goal ({gx:.2f}, {gy:.2f})"
+        frame = goal.header.frame_id or goals.header.frame_id
+        if frame and frame != map_frame:
+            self._fail(
+                nav_state, map_frame, f"{goal_text} is in frame '{frame}', not '{map_frame}'"
+            )
+            return
+        if not nav_state.has("robot_pose"):
+            self._fail(nav_state, map_frame, f"{goal_text}: no robot_pose yet")
+            return
+        robot = nav_state.get("robot_pose", Odometry)
+        if not robot.is_finite():
+            self._fail(nav_state, map_frame, f"{goal_text}: robot_pose is not finite")
+            return
+        if not nav_state.has(MAP_KEY):
+            self._fail(nav_state, map_frame, f"{goal_text}: no map yet (NavState '{MAP_KEY}')")
+            return
+        world = nav_state.get(MAP_KEY, SimpleMap)
+        result = self.planner.plan(world, (robot.pose.x, robot.pose.y), (gx, gy, gyaw))
+        if not result.ok:
+            self._fail(nav_state, map_frame, result.reason)
+            return
+        stamp = max(robot.header.stamp, goal.header.stamp)
+        path = Path.from_xy_yaw(result.poses, Header(stamp, map_frame))
+        self._write(nav_state, path, None, f"path of {result.length:.2f} m to {goal_text}")
+
+    def _fail(self, nav_state: NavState, map_frame: str, reason: str) -> None:
+        self._throttle.warn(self.logger, reason, f"{self.plugin_name}: no path: {reason}")
+        self._write(nav_state, Path(Header(self.now(), map_frame)), reason, reason)
+
+    def _write(self, nav_state: NavState, path: Path, failure: str | None, message: str) -> None:
+        nav_state.set(PATH_KEY, path)
+        level = DiagnosticLevel.WARN if failure else DiagnosticLevel.OK
+        # Written on changes only; the path length alone changing is not news.
+        summary = (int(level), failure or message.split(" m to ")[-1])
+        if summary != self._last_status:
+            self._last_status = summary
+            write_diagnostic(
+                nav_state,
+                DIAGNOSTIC_NAME,
+                DiagnosticStatus(
+                    level=level,
+                    message=message,
+                    hardware_id=HARDWARE_ID,
+                    values={"poses": str(len(path)), "plugin": self.plugin_name},
+                ),
+            )
+        publisher = self._publisher
+        if publisher is not None and publisher.get_subscription_count() > 0:
+            from easynav.core.ros.converters import path_to_msg
+
+            publisher.publish(path_to_msg(path))
