@@ -1,0 +1,179 @@
+"""SimplePathFollower: the algorithm of SimpleController (carrot + two PIDs), without ROS."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from easynav.controllers.pid_controller import PIDController
+from easynav.core.robot import RobotLimits
+from easynav.core.types import normalize_angle
+
+#: States reported with each command.
+NO_PATH = "no_path"
+FOLLOWING = "following"
+FINAL_ROTATION = "final_rotation"
+ARRIVED = "arrived"
+
+
+def carrot_on_path(path_xy: np.ndarray, position: np.ndarray, look_ahead: float) -> np.ndarray:
+    """The point ``look_ahead`` metres along ``path_xy`` beyond the point closest to ``position``.
+
+    The closest point is the projection on the nearest segment (not the nearest vertex), so a
+    robot between two poses follows the segment joining them; past the end, the last point.
+    """
+    if len(path_xy) == 1:
+        return path_xy[0].copy()
+    a, b = path_xy[:-1], path_xy[1:]
+    ab = b - a
+    length2 = np.einsum("ij,ij->i", ab, ab)
+    t = np.clip(
+        np.einsum("ij,ij->i", position - a, ab) / np.where(length2 > 0.0, length2, 1.0), 0.0, 1.0
+    )
+    projections = a + t[:, None] * ab
+    nearest = int(np.argmin(np.einsum("ij,ij->i", projections - position, projections - position)))
+    lengths = np.sqrt(length2)
+    # Arc length of the projection, then of every vertex.
+    s_vertices = np.concatenate(([0.0], np.cumsum(lengths)))
+    s_target = s_vertices[nearest] + t[nearest] * lengths[nearest] + look_ahead
+    if s_target >= s_vertices[-1]:
+        return path_xy[-1].copy()
+    segment = int(np.searchsorted(s_vertices, s_target, side="right") - 1)
+    fraction = (s_target - s_vertices[segment]) / lengths[segment] if lengths[segment] else 0.0
+    return path_xy[segment] + fraction * ab[segment]
+
+
+def _limit_change(
+    target: float, previous: float, speed_up: float, slow_down: float, dt: float
+) -> float:
+    """Move from ``previous`` toward ``target`` within the accelerations (per second)."""
+    if previous * target < 0.0:  # changing direction: slow down to zero first
+        target = 0.0
+    accel = speed_up if abs(target) > abs(previous) else slow_down
+    step = accel * dt
+    return min(max(target, previous - step), previous + step)
+
+
+class SimplePathFollower:
+    """Follows a path with a carrot ``look_ahead_dist`` ahead and PIDs on heading and distance.
+
+    Each step: the carrot is the point ``look_ahead_dist`` along the path beyond the robot's
+    projection on it; ``w = PID_angular(angle to the carrot)`` and
+    ``v = max(0, PID_linear(distance to the carrot) - k_rot·|w|)`` (slower while turning; never
+    backwards). Within ``tolerance_dist`` of the last pose the robot stops and turns to its yaw
+    (``FINAL_ROTATION``, kept until 2·``tolerance_dist`` so estimate noise does not toggle it),
+    then reports ``ARRIVED`` within ``final_goal_angle_tolerance`` and commands zero. Speeds are
+    clamped to the robot limits and changed within their accelerations (speeding up) and
+    decelerations (slowing down).
+
+    Thread contract: owned by the controller plugin, RT thread only; not locked.
+    Exceptions: :class:`ValueError` for parameters out of range (naming them).
+    """
+
+    def __init__(
+        self,
+        look_ahead_dist: float = 1.0,
+        tolerance_dist: float = 0.05,
+        final_goal_angle_tolerance: float = 0.1,
+        k_rot: float = 0.5,
+        linear_gains: tuple[float, float, float] = (0.95, 0.03, 0.08),
+        angular_gains: tuple[float, float, float] = (1.5, 0.03, 0.08),
+    ) -> None:
+        for name, value in (
+            ("look_ahead_dist", look_ahead_dist),
+            ("tolerance_dist", tolerance_dist),
+            ("final_goal_angle_tolerance", final_goal_angle_tolerance),
+            ("k_rot", k_rot),
+        ):
+            if not math.isfinite(value) or value < 0.0:
+                raise ValueError(f"{name} = {value} must be finite and >= 0")
+        self.look_ahead_dist = float(look_ahead_dist)
+        self.tolerance_dist = float(tolerance_dist)
+        self.final_goal_angle_tolerance = float(final_goal_angle_tolerance)
+        self.k_rot = float(k_rot)
+        # Outputs are saturated later by the robot limits; the PIDs only clamp their integral.
+        self.linear_pid = PIDController(*linear_gains, max_output=math.inf)
+        self.angular_pid = PIDController(*angular_gains, max_output=math.inf)
+        self._v = 0.0
+        self._w = 0.0
+        self._goal: tuple[float, float, float] | None = None
+        self._final_rotation = False
+
+    def reset(self) -> None:
+        """Forget the PID state, the last command and the final-rotation mode."""
+        self.linear_pid.reset()
+        self.angular_pid.reset()
+        self._v = self._w = 0.0
+        self._goal = None
+        self._final_rotation = False
+
+    def compute(
+        self,
+        pose_xy_yaw: tuple[float, float, float],
+        path_xy_yaw: np.ndarray,
+        dt: float,
+        limits: RobotLimits,
+        position_tolerance: float = math.inf,
+        yaw_tolerance: float = math.inf,
+    ) -> tuple[float, float, str]:
+        """``(v, w, state)`` for the robot at ``pose_xy_yaw`` following ``path_xy_yaw``.
+
+        ``path_xy_yaw``: ``(K, 3)`` array (an empty one gives zero and ``NO_PATH``).
+        ``position_tolerance``/``yaw_tolerance``: the goal manager's tolerances; the robot stops
+        within the tighter of these and its own, so it never stops short of what the goal
+        manager accepts as reached.
+        """
+        path = np.asarray(path_xy_yaw, dtype=float)
+        if path.ndim != 2 or len(path) == 0:
+            self.reset()
+            return 0.0, 0.0, NO_PATH
+        x, y, yaw = (float(v) for v in pose_xy_yaw)
+        goal = (float(path[-1, 0]), float(path[-1, 1]), float(path[-1, 2]))
+        if (
+            self._goal is None
+            or max(abs(a - b) for a, b in zip(goal, self._goal, strict=True)) > 1e-6
+        ):
+            self._goal = goal  # a new goal: decide the final approach afresh
+            self._final_rotation = False
+        stop_dist = min(self.tolerance_dist, position_tolerance)
+        stop_yaw = min(self.final_goal_angle_tolerance, yaw_tolerance)
+        dist_goal = math.hypot(goal[0] - x, goal[1] - y)
+        yaw_error = normalize_angle(goal[2] - yaw)
+
+        if dist_goal <= stop_dist or (self._final_rotation and dist_goal <= 2.0 * stop_dist):
+            self._final_rotation = True
+            self.linear_pid.reset()
+            if abs(yaw_error) <= stop_yaw:
+                self.angular_pid.reset()
+                self._v = self._w = 0.0
+                return 0.0, 0.0, ARRIVED
+            v_target = 0.0
+            w_target = self.angular_pid.output(yaw_error, dt)
+            # The dead band must not hold the robot short of a tighter goal tolerance.
+            if w_target == 0.0:
+                w_target = math.copysign(min(0.1, limits.max_angular_vel), yaw_error)
+            state = FINAL_ROTATION
+        else:
+            self._final_rotation = False
+            carrot = carrot_on_path(path[:, :2], np.array((x, y)), self.look_ahead_dist)
+            dx, dy = carrot[0] - x, carrot[1] - y
+            heading_error = normalize_angle(math.atan2(dy, dx) - yaw)
+            w_target = self.angular_pid.output(heading_error, dt)
+            v_target = max(
+                0.0, self.linear_pid.output(math.hypot(dx, dy), dt) - self.k_rot * abs(w_target)
+            )
+            state = FOLLOWING
+
+        v_target = min(v_target, max(limits.max_linear_vel, 0.0))
+        w_max = max(limits.max_angular_vel, 0.0)
+        w_target = min(max(w_target, -w_max), w_max)
+        if dt > 0.0:
+            v_target = _limit_change(
+                v_target, self._v, limits.max_linear_acc, limits.max_linear_decel, dt
+            )
+            w_target = _limit_change(
+                w_target, self._w, limits.max_angular_acc, limits.max_angular_decel, dt
+            )
+        self._v, self._w = v_target, w_target
+        return v_target, w_target, state

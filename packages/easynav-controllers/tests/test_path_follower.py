@@ -1,0 +1,119 @@
+"""PID, carrot and the path follower on a simulated unicycle."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from easynav.controllers import (
+    ARRIVED,
+    FINAL_ROTATION,
+    NO_PATH,
+    PIDController,
+    SimplePathFollower,
+    carrot_on_path,
+)
+from easynav.core.robot import RobotLimits
+
+
+def test_pid_dead_band_saturation_and_anti_windup():
+    pid = PIDController(1.0, 0.5, 0.0, max_output=2.0, dead_band=0.01)
+    assert pid.output(0.005, 0.1) == 0.0
+    assert pid.output(1.0, 0.1) == pytest.approx(1.0 + 0.5 * 0.1)
+    for _ in range(1000):
+        pid.output(10.0, 0.1)
+    assert pid.output(10.0, 0.1) == 2.0
+    # The integral is bounded: it unwinds within a few steps once the error changes sign.
+    steps = 0
+    while pid.output(-1.0, 0.1) >= 0.0:
+        steps += 1
+    assert steps <= 60  # ki·∫e is clamped to 2·max_output: 6 s of -1 error unwinds it
+    assert pid.output(1.0, 0.0) == 0.0
+    with pytest.raises(ValueError, match="kp = -1"):
+        PIDController(-1.0, 0.0, 0.0, 1.0)
+
+
+def test_carrot_is_look_ahead_beyond_the_projection():
+    path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [1.0, 2.0]])
+    assert carrot_on_path(path, np.array([0.5, 0.2]), 0.3) == pytest.approx([0.8, 0.0])
+    assert carrot_on_path(path, np.array([0.9, -0.1]), 0.5) == pytest.approx([1.0, 0.4])
+    assert carrot_on_path(path, np.array([1.1, 1.9]), 5.0) == pytest.approx([1.0, 2.0])
+    assert carrot_on_path(path[:1], np.array([3.0, 3.0]), 1.0) == pytest.approx([0.0, 0.0])
+
+
+def simulate(follower, path, start, limits=None, dt=1 / 30, seconds=60.0, **tol):
+    limits = limits or RobotLimits()
+    x, y, yaw = start
+    trace, states = [], []
+    for _ in range(int(seconds / dt)):
+        v, w, state = follower.compute((x, y, yaw), path, dt, limits, **tol)
+        states.append(state)
+        assert 0.0 <= v <= limits.max_linear_vel + 1e-12
+        assert abs(w) <= limits.max_angular_vel + 1e-12
+        trace.append((x, y, yaw, v, w))
+        if state == ARRIVED:
+            break
+        x += v * math.cos(yaw) * dt
+        y += v * math.sin(yaw) * dt
+        yaw += w * dt
+    return np.array(trace), states
+
+
+def l_shaped_path(goal_yaw=math.pi / 2):
+    leg1 = [(x, 0.0, 0.0) for x in np.arange(0.0, 3.0, 0.2)]
+    leg2 = [(3.0, y, math.pi / 2) for y in np.arange(0.0, 2.01, 0.2)]
+    path = np.array(leg1 + leg2)
+    path[-1, 2] = goal_yaw
+    return path
+
+
+def test_unicycle_reaches_the_end_of_the_path_within_tolerance():
+    follower = SimplePathFollower(look_ahead_dist=0.4)
+    path = l_shaped_path(goal_yaw=math.pi)
+    trace, states = simulate(follower, path, (0.0, 0.1, 0.3))
+    assert states[-1] == ARRIVED
+    x, y, yaw = trace[-1, :3]
+    assert math.hypot(x - 3.0, y - 2.0) <= 0.05
+    assert abs(math.remainder(yaw - math.pi, 2 * math.pi)) <= 0.1
+    assert FINAL_ROTATION in states  # stopped, then turned to the goal yaw
+    # It followed the L: never cut the corner by more than a few cm beyond look-ahead effects.
+    d_corner = np.hypot(trace[:, 0] - 3.0, trace[:, 1] - 0.0).min()
+    assert d_corner < 0.4
+    assert trace[:, 3].max() > 0.3  # it actually drove at a useful speed
+
+
+def test_goal_manager_tolerances_tighten_the_stop():
+    follower = SimplePathFollower(look_ahead_dist=0.4, tolerance_dist=0.2)
+    path = l_shaped_path()
+    trace, states = simulate(
+        follower, path, (0.0, 0.0, 0.0), position_tolerance=0.03, yaw_tolerance=0.01
+    )
+    assert states[-1] == ARRIVED
+    x, y, yaw = trace[-1, :3]
+    assert math.hypot(x - 3.0, y - 2.0) <= 0.03
+    assert abs(math.remainder(yaw - math.pi / 2, 2 * math.pi)) <= 0.01
+
+
+def test_accelerations_are_respected():
+    limits = RobotLimits(max_linear_vel=0.5, max_linear_acc=0.25, max_angular_acc=0.5)
+    follower = SimplePathFollower(look_ahead_dist=0.6)
+    dt = 0.05
+    trace, _ = simulate(follower, l_shaped_path(), (0.0, 0.0, 0.0), limits, dt=dt)
+    dv = np.diff(trace[:, 3])
+    dw = np.diff(trace[:, 4])
+    assert dv.max() <= limits.max_linear_acc * dt + 1e-9
+    assert -dv.max() <= limits.max_linear_decel * dt + 1e-9
+    speeding_up = np.abs(trace[1:, 4]) > np.abs(trace[:-1, 4])
+    assert np.abs(dw[speeding_up]).max() <= limits.max_angular_acc * dt + 1e-9
+
+
+def test_empty_path_gives_zero():
+    follower = SimplePathFollower()
+    assert follower.compute((0, 0, 0), np.zeros((0, 3)), 0.1, RobotLimits()) == (0.0, 0.0, NO_PATH)
+
+
+def test_bad_parameters_are_named():
+    with pytest.raises(ValueError, match="look_ahead_dist = -1"):
+        SimplePathFollower(look_ahead_dist=-1.0)
