@@ -66,8 +66,10 @@ class PointPerceptionsOps:
         tf_buffer: TFBuffer | None = None,
         logger: Any = None,
     ) -> None:
-        items = perceptions.items() if isinstance(perceptions, Mapping) else (
-            (f"#{i}", p) for i, p in enumerate(perceptions)
+        items = (
+            perceptions.items()
+            if isinstance(perceptions, Mapping)
+            else ((f"#{i}", p) for i, p in enumerate(perceptions))
         )
         self._chunks: list[_Chunk] = []
         for label, perception in items:
@@ -86,9 +88,7 @@ class PointPerceptionsOps:
         self._fused_stamp: float | None = None
 
     # -- operations ---------------------------------------------------------------------------
-    def filter(
-        self, min_xyz: Sequence[float], max_xyz: Sequence[float]
-    ) -> PointPerceptionsOps:
+    def filter(self, min_xyz: Sequence[float], max_xyz: Sequence[float]) -> PointPerceptionsOps:
         """Keep the points with ``min <= p <= max`` on every axis; a NaN bound is no bound."""
         low = _bounds(min_xyz, "filter min_xyz")
         high = _bounds(max_xyz, "filter max_xyz")

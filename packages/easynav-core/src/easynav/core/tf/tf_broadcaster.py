@@ -25,9 +25,7 @@ class TFBroadcaster:
     naming the frames for a non-finite one (nothing of the call is published then).
     """
 
-    def __init__(
-        self, node: Any, topic: str = "tf", local_buffer: TFBuffer | None = None
-    ) -> None:
+    def __init__(self, node: Any, topic: str = "tf", local_buffer: TFBuffer | None = None) -> None:
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from tf2_msgs.msg import TFMessage
 

@@ -370,4 +370,3 @@ class TFBuffer:
             f"'{history.parent}' -> '{history.child}' is available for "
             f"[{oldest:.3f}, {newest:.3f}] ({where})"
         )
-

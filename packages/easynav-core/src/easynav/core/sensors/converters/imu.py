@@ -22,9 +22,9 @@ def imu_from_msg(msg: Any) -> ImuPerception:
         orientation=np.array((o.x, o.y, o.z, o.w)),
         orientation_covariance=np.array(msg.orientation_covariance, dtype=float).reshape(3, 3),
         angular_velocity=np.array((w.x, w.y, w.z)),
-        angular_velocity_covariance=np.array(
-            msg.angular_velocity_covariance, dtype=float
-        ).reshape(3, 3),
+        angular_velocity_covariance=np.array(msg.angular_velocity_covariance, dtype=float).reshape(
+            3, 3
+        ),
         linear_acceleration=np.array((a.x, a.y, a.z)),
         linear_acceleration_covariance=np.array(
             msg.linear_acceleration_covariance, dtype=float
