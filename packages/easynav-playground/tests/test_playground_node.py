@@ -13,7 +13,7 @@ import pytest
 pytestmark = pytest.mark.ros
 
 
-def wait_for(predicate, timeout=5.0):
+def wait_for(predicate, timeout=10.0):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         if predicate():
@@ -112,7 +112,7 @@ def test_node_publishes_sensors_clock_tf_and_moves_on_cmd_vel(ros_bed, tmp_path)
             probe.cmd_pub.publish(command)
             time.sleep(0.05)
         assert wait_for(
-            lambda: received["/ground_truth"][-1].pose.pose.position.x > start_x + 0.2, 3.0
+            lambda: received["/ground_truth"][-1].pose.pose.position.x > start_x + 0.2, 10.0
         )
         assert received["/odom"][-1].pose.pose.position.x > 0.2
         assert received["/odom"][-1].twist.twist.linear.x > 0.2

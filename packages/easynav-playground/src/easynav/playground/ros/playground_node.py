@@ -262,10 +262,12 @@ class PlaygroundNode(Node):
 
     # ------------------------------------------------------------------ simulation thread
     def _tick(self) -> None:
-        self.sim.step()
+        # /clock first: the messages of this step are stamped with its end time, and a
+        # subscriber must never receive data stamped ahead of its clock.
         clock = Clock()
-        clock.clock = messages.stamp_msg(self.sim.time)
+        clock.clock = messages.stamp_msg((self.sim.steps + 1) * self.sim.step_size)
         self._clock_pub.publish(clock)
+        self.sim.step()
 
     def _publish_scan(self, stamp: float, ranges: np.ndarray) -> None:
         self._scan_pub.publish(
