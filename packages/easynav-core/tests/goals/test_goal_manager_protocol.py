@@ -219,3 +219,27 @@ def test_own_messages_continue_the_owners_sequence():
     clock.advance(0.01)
     msgs = manager.update()
     assert [(m.type, m.seq) for m in msgs] == [(T.FINISHED, 15)]
+
+
+def test_warnings_name_the_sender_and_work_with_a_ros_style_logger():
+    class RosStyleLogger:  # rclpy's logger takes one string, no %-arguments
+        def __init__(self):
+            self.lines = []
+
+        def info(self, text):
+            self.lines.append(text)
+
+        def warning(self, text):
+            self.lines.append(text)
+
+    from easynav.core.goals import GoalManager, GoalManagerParams
+    from easynav.core.nav_state import NavState
+
+    logger = RosStyleLogger()
+    manager = GoalManager(NavState(), GoalManagerParams(), lambda: 0.0, logger=logger)
+    manager.handle_control(control(T.ACCEPT, "confused_tool"))
+    manager.abort_mission("nothing")
+    assert logger.lines == [
+        "goal manager: unexpected ACCEPT message from 'confused_tool'",
+        "abort_mission('nothing') ignored: no mission under way",
+    ]

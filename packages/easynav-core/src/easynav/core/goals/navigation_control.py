@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass, field
 
+from easynav.core.goals.copies import copy_goals, copy_header, copy_pose_stamped
 from easynav.core.goals.navigation_control_type import NavigationControlType
 from easynav.core.types import Goals, Header, PoseStamped
 
@@ -38,7 +38,20 @@ class NavigationControl:
 
     def copy(self) -> NavigationControl:
         """A deep copy (goals and poses included)."""
-        return copy.deepcopy(self)
+        return NavigationControl(
+            type=self.type,
+            header=copy_header(self.header),
+            seq=self.seq,
+            user_id=self.user_id,
+            nav_current_user_id=self.nav_current_user_id,
+            goals=copy_goals(self.goals),
+            status_message=self.status_message,
+            current_pose=copy_pose_stamped(self.current_pose),
+            navigation_time=self.navigation_time,
+            estimated_time_remaining=self.estimated_time_remaining,
+            distance_covered=self.distance_covered,
+            distance_to_goal=self.distance_to_goal,
+        )
 
     @property
     def type_name(self) -> str:
