@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import gc
+import os
 import signal
 import sys
 import threading
@@ -93,7 +95,7 @@ class EasyNavRuntime:
         """Start the loops, then configure and activate. False (and ``error``) on failure."""
         # A short GIL switch interval keeps the RT thread's jitter low (ENVIRONMENT.md:
         # p99 5 ms → 0.1 ms with a CPU-bound thread in the process).
-        sys.setswitchinterval(0.0005)
+        sys.setswitchinterval(float(os.environ.get("EASYNAV_SWITCH_INTERVAL", "0.0005")))
         node = self.system_node
         node.trigger_configure()
         if node.lifecycle_state() != "inactive":
@@ -125,6 +127,10 @@ class EasyNavRuntime:
         if node.lifecycle_state() != "active":
             self.error = node.error_message or "activate failed"
             return False
+        # Objects alive now (nodes, plugins, maps) are never garbage: keep the cyclic collector
+        # from walking them during cycles.
+        gc.collect()
+        gc.freeze()
         self.logger.info("EasyNav is active")
         return True
 

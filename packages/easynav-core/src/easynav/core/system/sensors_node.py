@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
-
 from easynav.core.sensors import SensorsManager
 from easynav.core.system.component_node import ComponentNode
+from easynav.core.tf import TFListener
 
 
 class SensorsNode(ComponentNode):
@@ -22,6 +21,8 @@ class SensorsNode(ComponentNode):
     def __init__(self, namespace, system, **kwargs):
         super().__init__("sensors_node", namespace, system, **kwargs)
         self.manager: SensorsManager | None = None
+        # TF is received on the RT side, like the sensors whose points it places.
+        self.tf_listener = TFListener(self)
 
     def load_plugins(self) -> None:
         # Perception handlers are chosen per sensor by the manager, not listed as plugins.
@@ -32,9 +33,6 @@ class SensorsNode(ComponentNode):
         if self.manager is not None:
             self.manager.cleanup()
             self.manager = None
-
-    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
-        return super().on_activate(state)
 
     def new_data_pending(self) -> bool:
         """True when a sensor callback stored data the RT cycle has not consumed. RT thread."""
