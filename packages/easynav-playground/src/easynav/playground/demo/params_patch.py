@@ -1,0 +1,97 @@
+"""Deriving the demo's params file: the map and start pose of the world being run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+SIMPLE_MAPS_MANAGER = "easynav_simple_maps_manager/SimpleMapsManager"
+
+
+def _get(section: dict, dotted: str, default=None):
+    """A parameter of a node section, nested (``a: {b: 1}``) or flat (``a.b: 1``)."""
+    if dotted in section:
+        return section[dotted]
+    node = section
+    for part in dotted.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return default
+        node = node[part]
+    return node
+
+
+def _set(section: dict, dotted: str, value) -> None:
+    """Set a parameter where it is written (flat key if present), nested otherwise."""
+    if dotted in section:
+        section[dotted] = value
+        return
+    parts = dotted.split(".")
+    node = section
+    for part in parts[:-1]:
+        node = node.setdefault(part, {})
+    node[parts[-1]] = value
+
+
+def _ros_parameters(params: dict, node: str) -> dict | None:
+    section = params.get(node)
+    if not isinstance(section, dict):
+        return None
+    return section.get("ros__parameters")
+
+
+def derive_params(
+    params_path: Path, map_file: Path, start_pose: tuple[float, float, float], out_path: Path
+) -> tuple[list[str], str | None]:
+    """Write ``out_path``: the params file with the world's map and start pose, sim time on.
+
+    - every ``SimpleMapsManager`` alias loads ``map_file`` (``package`` emptied);
+    - every localizer alias with an ``initial_pose`` starts at ``start_pose``;
+    - ``use_sim_time: true`` on every node (the playground's /clock is the time).
+
+    Returns the notes of what was changed and the planner's debug path topic (None without a
+    planner).
+
+    Raises:
+        FileNotFoundError: no params file.
+        ValueError: not an EasyNav params file (no ``<node>: ros__parameters:`` section).
+    """
+    params = yaml.safe_load(Path(params_path).read_text())
+    if not isinstance(params, dict) or not any(
+        isinstance(v, dict) and "ros__parameters" in v for v in params.values()
+    ):
+        raise ValueError(f"{params_path}: not a ROS params file (no '<node>: ros__parameters:')")
+    notes = []
+    for node, section in params.items():
+        if isinstance(section, dict) and isinstance(section.get("ros__parameters"), dict):
+            if section["ros__parameters"].get("use_sim_time") is not True:
+                notes.append(f"{node}.use_sim_time set to true (the playground's /clock)")
+            section["ros__parameters"]["use_sim_time"] = True
+
+    maps = _ros_parameters(params, "maps_manager_node") or {}
+    for alias in maps.get("map_types", []) or []:
+        if _get(maps, f"{alias}.plugin") == SIMPLE_MAPS_MANAGER:
+            _set(maps, f"{alias}.package", "")
+            _set(maps, f"{alias}.map_path_file", str(map_file))
+            notes.append(f"maps_manager_node.{alias} loads the world's map {map_file}")
+        else:
+            notes.append(
+                f"maps_manager_node.{alias} ({_get(maps, f'{alias}.plugin')}) keeps the map of "
+                "the params file: make sure it is the world's"
+            )
+
+    localizer = _ros_parameters(params, "localizer_node") or {}
+    x, y, yaw = start_pose
+    for alias in localizer.get("localizer_types", []) or []:
+        if _get(localizer, f"{alias}.initial_pose") is not None:
+            for key, value in (("x", x), ("y", y), ("yaw", yaw)):
+                _set(localizer, f"{alias}.initial_pose.{key}", float(value))
+            notes.append(
+                f"localizer_node.{alias}.initial_pose = ({x:.2f}, {y:.2f}, {yaw:.2f}), the start"
+            )
+
+    planner = _ros_parameters(params, "planner_node") or {}
+    planner_types = planner.get("planner_types", []) or []
+    path_topic = f"/planner_node/{planner_types[0]}/path" if planner_types else None
+    Path(out_path).write_text(yaml.safe_dump(params, sort_keys=False))
+    return notes, path_topic

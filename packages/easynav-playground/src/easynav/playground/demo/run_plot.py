@@ -1,0 +1,110 @@
+"""The picture of a demo run (matplotlib, Agg backend: no display needed)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from easynav.playground.demo.waypoint_result import WaypointResult
+from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.world import World
+
+
+def plot_run(
+    path: str | Path,
+    world: World,
+    waypoints: Sequence[WaypointResult] = (),
+    start_pose: tuple[float, float, float] | None = None,
+    true_poses: Sequence[Sequence[float]] = (),
+    estimated_poses: Sequence[Sequence[float]] = (),
+    planned_paths: Sequence[np.ndarray] = (),
+    collisions: Sequence[dict] = (),
+    obstacles: Sequence[MovingObstacle] = (),
+    title: str = "",
+) -> None:
+    """Draw the world, moving-obstacle tracks, planned paths, the true and estimated
+    trajectories, the waypoints (green reached, red not) and collisions; save as PNG.
+
+    Any thread (matplotlib's object API with the Agg canvas, no global pyplot state).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    min_x, min_y, max_x, max_y = world.bounds
+    aspect = (max_y - min_y) / (max_x - min_x)
+    fig = Figure(figsize=(10, max(4.0, min(10 * aspect, 14)) + 0.8), dpi=100)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.imshow(
+        world.occupied,
+        origin="lower",
+        cmap="Greys",
+        vmin=0,
+        vmax=1.4,
+        extent=(min_x, max_x, min_y, max_y),
+        interpolation="nearest",
+    )
+    for i, o in enumerate(obstacles):
+        ax.plot(
+            *o.waypoints.T,
+            ls=":",
+            color="purple",
+            lw=2,
+            label="moving obstacle track" if i == 0 else None,
+        )
+    for i, p in enumerate(planned_paths):
+        ax.plot(
+            p[:, 0],
+            p[:, 1],
+            color="tab:blue",
+            lw=0.8,
+            alpha=0.35,
+            label="planned paths" if i == 0 else None,
+        )
+    if len(true_poses):
+        t = np.asarray(true_poses)
+        ax.plot(t[:, 1], t[:, 2], color="black", lw=1.6, label="true trajectory")
+    if len(estimated_poses):
+        e = np.asarray(estimated_poses)
+        ax.plot(e[:, 1], e[:, 2], color="tab:orange", lw=1.2, ls="--", label="EasyNav estimate")
+    if start_pose is not None:
+        ax.plot(*start_pose[:2], marker="s", color="tab:blue", ms=9, ls="none", label="start")
+    for w in waypoints:
+        color = "tab:green" if w.reached else "tab:red"
+        ax.plot(w.x, w.y, marker="o", ms=13, color=color, mec="black", ls="none")
+        ax.annotate(
+            str(w.index),
+            (w.x, w.y),
+            ha="center",
+            va="center",
+            fontsize=8,
+            color="white",
+            weight="bold",
+        )
+        ax.arrow(w.x, w.y, 0.4 * math.cos(w.yaw), 0.4 * math.sin(w.yaw), width=0.03, color=color)
+    for i, c in enumerate(collisions):
+        ax.plot(
+            c["x"],
+            c["y"],
+            marker="X",
+            ms=14,
+            color="red",
+            mec="black",
+            ls="none",
+            label="collision" if i == 0 else None,
+        )
+    ax.plot([], [], marker="o", color="tab:green", ls="none", label="waypoint reached")
+    ax.plot([], [], marker="o", color="tab:red", ls="none", label="waypoint not reached")
+    ax.set_xlim(min_x, max_x)
+    ax.set_ylim(min_y, max_y)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if title:
+        ax.set_title(title, fontsize=10)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    fig.tight_layout()
+    fig.savefig(str(path))

@@ -1,0 +1,131 @@
+"""RunSummary: the figures of a demo run and its table."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from easynav.playground.demo.waypoint_result import WaypointResult
+from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
+
+
+@dataclass
+class RunSummary:
+    """What the demo reports: per-waypoint results and whole-run figures.
+
+    Built by :meth:`compute` from the playground's ground truth (with EasyNav's estimates
+    added) and the waypoint events seen during the run.
+
+    Thread contract: plain data, built after the run.
+    """
+
+    waypoints: list[WaypointResult]
+    final_state: str
+    status_message: str = ""
+    nav_start: float = 0.0
+    nav_end: float = 0.0
+    distance_driven: float = 0.0
+    min_clearance: float = math.nan
+    collisions: list[dict] = field(default_factory=list)
+    localisation_mean: float = math.nan
+    localisation_max: float = math.nan
+    localisation_samples: int = 0
+    command_rate: float = 0.0
+    real_time_factor: float = math.nan
+
+    @property
+    def all_reached(self) -> bool:
+        """Every waypoint reached."""
+        return all(w.reached for w in self.waypoints)
+
+    @property
+    def success(self) -> bool:
+        """Every waypoint reached and no collision: the demo's exit code 0."""
+        return self.all_reached and not self.collisions
+
+    @classmethod
+    def compute(
+        cls,
+        waypoints: list[WaypointResult],
+        truth: GroundTruthRecorder,
+        final_state: str,
+        status_message: str,
+        nav_start: float,
+        nav_end: float,
+        command_rate: float,
+        real_time_factor: float = math.nan,
+    ) -> RunSummary:
+        """Fill the legs of the reached waypoints and the whole-run figures.
+
+        ``truth`` holds the true trajectory, clearances and collisions (the playground's
+        record) and EasyNav's estimated poses.
+        """
+        previous = nav_start
+        for w in waypoints:
+            if w.reached_at is None:
+                continue
+            w.leg_time = w.reached_at - previous
+            w.leg_distance = truth.distance_driven(previous, w.reached_at)
+            at = truth.true_pose_at(w.reached_at)
+            if at is not None:
+                w.arrival_error = math.hypot(at[0] - w.x, at[1] - w.y)
+            previous = w.reached_at
+        in_run = [c for c in truth.clearances if nav_start <= c[0] <= nav_end]
+        errors = truth.localisation_errors()
+        return cls(
+            waypoints=waypoints,
+            final_state=final_state,
+            status_message=status_message,
+            nav_start=nav_start,
+            nav_end=nav_end,
+            distance_driven=truth.distance_driven(nav_start, nav_end),
+            min_clearance=min((c[1] for c in in_run), default=math.nan),
+            collisions=list(truth.collisions),
+            localisation_mean=float(np.mean(errors)) if errors.size else math.nan,
+            localisation_max=float(np.max(errors)) if errors.size else math.nan,
+            localisation_samples=int(errors.size),
+            command_rate=command_rate,
+            real_time_factor=real_time_factor,
+        )
+
+    def format_table(self) -> str:
+        """The summary as plain text: a waypoint table, then the run figures."""
+
+        def num(value: float, fmt: str) -> str:
+            return "-" if value is None or math.isnan(value) else format(value, fmt)
+
+        lines = [
+            " #      x      y    yaw  reached   time(s)  driven(m)  off(m)",
+            "-- ------ ------ ------  -------  --------  ---------  ------",
+        ]
+        for w in self.waypoints:
+            lines.append(
+                f"{w.index:2d} {w.x:6.2f} {w.y:6.2f} {w.yaw:6.2f}  "
+                f"{'yes' if w.reached else 'NO':>7}  {num(w.leg_time, '8.1f'):>8}  "
+                f"{num(w.leg_distance, '9.2f'):>9}  {num(w.arrival_error, '6.3f'):>6}"
+            )
+        reached = sum(w.reached for w in self.waypoints)
+        lines += [
+            "",
+            f"result:               {self.final_state}"
+            + (f" ({self.status_message})" if self.status_message else ""),
+            f"waypoints reached:    {reached} of {len(self.waypoints)}",
+            f"navigation time:      {self.nav_end - self.nav_start:.1f} s (simulated)",
+            f"distance driven:      {self.distance_driven:.2f} m",
+            f"min clearance:        {num(self.min_clearance, '.3f')} m (robot edge to obstacles)",
+            f"collisions:           {len(self.collisions)}",
+            f"localisation error:   mean {num(self.localisation_mean, '.3f')} m, "
+            f"max {num(self.localisation_max, '.3f')} m ({self.localisation_samples} samples)",
+            f"velocity commands:    {self.command_rate:.1f} Hz (simulated time)",
+        ]
+        if not math.isnan(self.real_time_factor):
+            lines.append(f"simulation speed:     x{self.real_time_factor:.2f} real time")
+        for c in self.collisions:
+            lines.append(
+                f"  collision with {c.get('with')} at ({c.get('x', 0):.2f}, {c.get('y', 0):.2f}), "
+                f"t={c.get('stamp', 0):.1f} s"
+            )
+        lines.append(f"verdict:              {'SUCCESS' if self.success else 'FAILURE'}")
+        return "\n".join(lines)
