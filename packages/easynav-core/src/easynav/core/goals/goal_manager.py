@@ -130,7 +130,8 @@ class GoalManager:
         self._position_distance = 0.0
         self._angle_distance = 0.0
         self._final_info_pending = False
-        self._infos: deque[GoalManagerInfo] = deque()
+        # Bounded like the topic's queue: a host that never drains info() must not grow memory.
+        self._infos: deque[GoalManagerInfo] = deque(maxlen=p.QUEUE_DEPTH)
 
         # Written now (not at the first update) so controllers and the planner find every key,
         # and so a NavState that outlived an earlier instance holds no stale mission.
@@ -225,7 +226,8 @@ class GoalManager:
         """The next GoalManagerInfo to publish on ``easynav_manager_info``, oldest first; None
         when there is nothing more. Call it until None after each :meth:`update`. ACTIVE ones
         come with each FEEDBACK; one IDLE comes at the end of each mission (not after a
-        preemption, which hands the mission to another owner without going idle). Non-RT thread.
+        preemption, which hands the mission to another owner without going idle). At most the
+        last 100 wait (the topic's depth). Non-RT thread.
         """
         with self._lock:
             return self._infos.popleft() if self._infos else None
