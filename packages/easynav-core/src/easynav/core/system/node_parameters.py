@@ -5,7 +5,11 @@ from __future__ import annotations
 from typing import Any
 
 from rcl_interfaces.msg import ParameterDescriptor
-from rclpy.exceptions import InvalidParameterTypeException, ParameterException
+from rclpy.exceptions import (
+    InvalidParameterTypeException,
+    ParameterException,
+    ParameterUninitializedException,
+)
 from rclpy.parameter import Parameter
 
 from easynav.core.plugins.plugin_context import ParameterAccess
@@ -33,7 +37,10 @@ class NodeParameters(ParameterAccess):
     def declare(self, name: str, default: Any, description: str = "") -> Any:
         node = self._node
         if node.has_parameter(name):
-            return node.get_parameter(name).value
+            try:
+                return node.get_parameter(name).value
+            except ParameterUninitializedException:  # an empty list declared by type only
+                return default
         descriptor = ParameterDescriptor(description=description)
         override = node._parameter_overrides.get(name)  # rclpy keeps them here, by full name
         try:
