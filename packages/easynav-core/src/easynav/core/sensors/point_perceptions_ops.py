@@ -19,6 +19,28 @@ _LOGGER = logging.getLogger("easynav.sensors")
 _THROTTLE = WarningThrottle(period=5.0)
 
 
+def transform_points(points: np.ndarray, values: tuple[float, ...]) -> np.ndarray:
+    """``points`` (N, 3) moved by ``(tx, ty, tz, qx, qy, qz, qw)``, as a new float64 array.
+
+    Column by column on purpose: ``points @ R.T`` goes through BLAS, which for a 3x3 operand is
+    3-20x slower than three fused multiply-adds per column (measured in bench_perception.py).
+    """
+    tx, ty, tz, qx, qy, qz, qw = values
+    rot = rotation_matrix(qx, qy, qz, qw)
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    out = np.empty((points.shape[0], 3), dtype=np.float64)
+    scratch = np.empty(points.shape[0], dtype=np.float64)  # one temporary, reused
+    for axis, (row, offset) in enumerate(zip(rot, (tx, ty, tz), strict=True)):
+        column = out[:, axis]
+        np.multiply(x, row[0], out=column)
+        np.multiply(y, row[1], out=scratch)
+        column += scratch
+        np.multiply(z, row[2], out=scratch)
+        column += scratch
+        column += offset
+    return out
+
+
 class _Chunk:
     """Points of one source (a perception, or the fused cloud) and where they are."""
 
@@ -218,11 +240,7 @@ class PointPerceptionsOps:
                 f"'{target_frame}' is not finite: {values}",
             )
             return None
-        tx, ty, tz, qx, qy, qz, qw = values
-        rot = np.array(rotation_matrix(qx, qy, qz, qw))
-        out = chunk.points @ rot.T
-        out += (tx, ty, tz)
-        return out
+        return transform_points(chunk.points, values)
 
     # -- results ------------------------------------------------------------------------------
     def as_points(self) -> np.ndarray:

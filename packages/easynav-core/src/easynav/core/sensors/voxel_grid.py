@@ -6,10 +6,16 @@ import math
 
 import numpy as np
 
-# Mixed-radix packing of the three voxel indices into one int64 is exact while the product of
-# the index ranges stays below 2**62; beyond that (huge extents at tiny resolutions) the rows are
-# compared as triples, which is slower but still exact.
-_PACKABLE = 2**62
+# Mixed-radix packing of the three voxel indices into one number is exact while the product of
+# the index ranges stays below 2**53 (computed in float64); beyond that (huge extents at tiny
+# resolutions) the rows are compared as triples, which is slower but still exact.
+_EXACT_FLOAT = 2**53
+# Dense path: a table with one int32 cell per voxel of the bounding box finds the first point of
+# each voxel in O(N + cells), ~8x faster than sorting 100k keys (measured in
+# benchmarks/bench_perception.py). Used while the table is at most this many cells per point
+# (plus a constant, so small clouds in big boxes still qualify); otherwise sorting is cheaper.
+_DENSE_CELLS_PER_POINT = 16
+_DENSE_EXTRA_CELLS = 1 << 16
 
 
 def voxel_downsample_indices(points: np.ndarray, resolution: float) -> np.ndarray:
@@ -20,40 +26,56 @@ def voxel_downsample_indices(points: np.ndarray, resolution: float) -> np.ndarra
     keeps the input order (a scan stays sorted by angle). Voxel ``(i, j, k)`` holds the points
     with ``floor(x / resolution) == i`` (and so on): floor bucketing, so voxels do not straddle 0.
 
-    Raises ``ValueError`` when ``resolution`` is not finite and > 0.
+    Raises ``ValueError`` when ``resolution`` is not finite and > 0, or when a coordinate is so
+    large that its voxel index does not fit in 52 bits.
     """
     if not (math.isfinite(resolution) and resolution > 0.0):
         raise ValueError(f"downsample resolution = {resolution!r} must be finite and > 0")
     n = points.shape[0]
     if n <= 1:
         return np.arange(n)
-    floored = np.floor(points / resolution)
-    low = floored.min(axis=0)
-    high = floored.max(axis=0)
-    if max(abs(low).max(), abs(high).max()) >= 2.0**62:
-        raise ValueError(
-            f"downsample: points up to {np.abs(points).max():.3g} m cannot be bucketed at "
-            f"resolution {resolution:g} (voxel index beyond int64)"
-        )
-    keys = floored.astype(np.int64)
-    kx, ky, kz = keys[:, 0], keys[:, 1], keys[:, 2]
-    x0, y0, z0 = (int(v) for v in low)
-    x1, y1, z1 = (int(v) for v in high)
-    ry, rz = y1 - y0 + 1, z1 - z0 + 1
-    if (x1 - x0 + 1) * ry * rz < _PACKABLE:
-        packed = (kx - x0) * (ry * rz)
-        packed += (ky - y0) * rz
-        packed += kz - z0
-        # A stable sort keeps equal keys in input order: the first of each run is the first
-        # point of that voxel.
-        order = np.argsort(packed, kind="stable")
-        sorted_keys = packed[order]
-        first = np.empty(n, dtype=bool)
-        first[0] = True
-        np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=first[1:])
-        return np.sort(order[first])
-    _, index = np.unique(keys, axis=0, return_index=True)
-    return np.sort(index)
+    # Column by column: reductions along axis 0 of an (N, 3) array are ~20x slower in numpy.
+    # Indices stay in float64 (exact for integers below 2**53) and are combined in place: every
+    # 100k-point temporary avoided is ~1 ms of page faults in a process that frees its arrays.
+    floored = []
+    span = []
+    for axis in range(3):
+        column = points[:, axis] / resolution
+        np.floor(column, out=column)
+        lo, hi = float(column.min()), float(column.max())
+        if max(-lo, hi) >= 2.0**52:
+            raise ValueError(
+                f"downsample: points up to {max(-lo, hi) * resolution:.3g} m cannot be bucketed "
+                f"at resolution {resolution:g} (voxel index beyond 2**52)"
+            )
+        column -= lo
+        floored.append(column)
+        span.append(int(hi - lo) + 1)
+    cells = span[0] * span[1] * span[2]
+    if cells >= _EXACT_FLOAT:
+        _, index = np.unique(np.column_stack(floored).astype(np.int64), axis=0, return_index=True)
+        return np.sort(index)
+    packed_f = floored[0]
+    packed_f *= span[1] * span[2]
+    floored[1] *= span[2]
+    packed_f += floored[1]
+    packed_f += floored[2]
+    packed = packed_f.astype(np.int64)
+    if cells <= _DENSE_CELLS_PER_POINT * n + _DENSE_EXTRA_CELLS and n < 2**31:
+        # Store n - index and keep the maximum: the first point wins, and the table can start
+        # as zeros (calloc: pages the cloud never touches cost nothing).
+        rank = np.arange(n, 0, -1, dtype=np.int32)
+        first = np.zeros(cells, dtype=np.int32)
+        np.maximum.at(first, packed, rank)  # unbuffered: correct with repeated voxels
+        return np.flatnonzero(first[packed] == rank)
+    # A stable sort keeps equal keys in input order: the first of each run is the first point
+    # of that voxel.
+    order = np.argsort(packed, kind="stable")
+    sorted_keys = packed[order]
+    is_first = np.empty(n, dtype=bool)
+    is_first[0] = True
+    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=is_first[1:])
+    return np.sort(order[is_first])
 
 
 def voxel_downsample(points: np.ndarray, resolution: float) -> np.ndarray:

@@ -83,18 +83,23 @@ def points_from_point_cloud2(msg: Any) -> tuple[np.ndarray, int]:
             np.lib.stride_tricks.as_strided(data, (height, row_bytes), (row_step, 1))
         ).reshape(-1)
     records = np.frombuffer(data, dtype=dtype, count=n)
-    points = np.empty((n, 3), dtype=np.float64)
-    points[:, 0] = records["x"]
-    points[:, 1] = records["y"]
-    points[:, 2] = records["z"]
-    # A NaN or inf coordinate makes the row sum non-finite; float32 inputs cannot overflow it.
+    # Column by column: contiguous 1-D passes, several times faster than axis reductions on an
+    # (N, 3) array.
+    x = records["x"].astype(np.float64)
+    y = records["y"].astype(np.float64)
+    z = records["z"].astype(np.float64)
     if dtype["x"].itemsize == 4 and dtype["y"].itemsize == 4 and dtype["z"].itemsize == 4:
-        finite = np.isfinite(points.sum(axis=1))
+        # A NaN or inf coordinate makes the sum non-finite; float32 values cannot overflow it.
+        finite = np.isfinite(x + y + z)
     else:
-        finite = np.isfinite(points).all(axis=1)
+        finite = np.isfinite(x) & np.isfinite(y) & np.isfinite(z)
     kept = int(np.count_nonzero(finite))
     if kept != n:
-        points = points[finite]
+        x, y, z = x[finite], y[finite], z[finite]
+    points = np.empty((kept, 3), dtype=np.float64)
+    points[:, 0] = x
+    points[:, 1] = y
+    points[:, 2] = z
     return points, n - kept
 
 
