@@ -1,0 +1,430 @@
+"""AMCLLocalizer (easynav_simple_localizer/AMCLLocalizer): a particle filter on the simple map."""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import numpy as np
+
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import LocalizerMethodBase, PluginConfigurationError
+from easynav.core.sensors import PointPerception, PointPerceptionsOps
+from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import (
+    Header,
+    Odometry,
+    Pose,
+    Transform,
+    TransformStamped,
+    Twist,
+    normalize_angle,
+    yaw_to_quaternion,
+)
+from easynav.localizers.particle_filter import (
+    ParticleFilter2D,
+    hit_fractions,
+    likelihood_field,
+)
+from easynav.maps import SimpleMap
+
+#: NavState keys.
+MAP_KEY = "map.base"
+POSE_KEY = "robot_pose"
+COVARIANCE_TRACE_KEY = "localizer.amcl.covariance_trace"
+#: Points at or below this height in the robot footprint frame are ground (the original's).
+MIN_POINT_Z = 0.1
+
+#: Parameters and defaults of the original.
+DEFAULTS = {
+    "num_particles": 100,
+    "initial_pose.x": 0.0,
+    "initial_pose.y": 0.0,
+    "initial_pose.yaw": 0.0,
+    "initial_pose.std_dev_xy": 0.5,
+    "initial_pose.std_dev_yaw": 0.5,
+    "reseed_freq": 1.0,
+    "noise_translation": 0.01,
+    "noise_rotation": 0.01,
+    "noise_translation_to_rotation": 0.01,
+    "min_noise_xy": 0.05,
+    "min_noise_yaw": 0.05,
+    # Not in the original (which counted exact hits, sigma 0): see likelihood_field.
+    "hit_sigma": 0.2,
+}
+
+
+def _xy_yaw(pose: Pose) -> tuple[float, float, float]:
+    return pose.x, pose.y, pose.yaw
+
+
+class AMCLLocalizer(LocalizerMethodBase):
+    """Monte Carlo localisation on NavState ``map.base`` with odometry from the ``odom`` topic.
+
+    - Prediction (``update_rt``, RT thread): each new odometry increment moves the particles
+      (noise ``noise_translation``, ``noise_rotation``, ``noise_translation_to_rotation``, see
+      :class:`ParticleFilter2D`), then ``robot_pose`` is written and ``map → odom`` broadcast.
+    - Correction (``update``, non-RT thread): the ungrouped point perceptions, fused into the
+      robot footprint frame, above z 0.1 m and downsampled to the map resolution, are scored
+      per particle by the fraction that hits occupied cells of ``map.base`` (a soft hit, see
+      ``hit_sigma`` and :func:`likelihood_field`); the weights are
+      multiplied by it, the cloud is resampled (low variance) when its effective size drops
+      below half, and every ``1/reseed_freq`` s the lower-weight half is redrawn around the
+      upper half (at least ``min_noise_xy``/``min_noise_yaw`` apart).
+
+    Parameters (under ``<alias>.``, defaults of the original): ``num_particles`` (100),
+    ``initial_pose.{x, y, yaw}`` (0), ``initial_pose.std_dev_xy`` (0.5 m),
+    ``initial_pose.std_dev_yaw`` (0.5 rad), ``reseed_freq`` (1.0 Hz), ``noise_translation``,
+    ``noise_rotation``, ``noise_translation_to_rotation`` (0.01), ``min_noise_xy``,
+    ``min_noise_yaw`` (0.05). Added here: ``hit_sigma`` (0.2 m): a point ``d`` metres from the
+    nearest occupied cell counts ``exp(-d²/2σ²)`` of a hit; 0 counts only points on occupied
+    cells, as the original did (it converges more slowly and can lock onto a wrong pose).
+
+    NavState: reads ``map.base`` (:class:`SimpleMap`) and every ungrouped
+    :class:`PointPerception`; writes ``robot_pose`` (:class:`Odometry` in the map frame, child
+    the robot footprint frame, stamp of the odometry used, covariance of the particles, twist of
+    the odometry) and ``localizer.amcl.covariance_trace`` (float: var x + var y + var yaw).
+
+    ROS (when hosted by a node): subscribes ``odom`` (nav_msgs/Odometry) and ``initialpose``
+    (geometry_msgs/PoseWithCovarianceStamped, map frame or empty: resets the cloud); publishes
+    ``<fqn>/<alias>/particles`` (PoseArray) and ``<fqn>/<alias>/pose``
+    (PoseWithCovarianceStamped) after each correction while subscribed; broadcasts ``map → odom``
+    on ``tf`` (and into this process's TF buffer, also without a node).
+
+    Thread contract: ``update_rt`` in the RT thread; ``update``, the ROS callbacks,
+    :meth:`set_odometry`, :meth:`reset_pose` and ``on_last_known_pose`` from the non-RT side.
+    One lock guards the particles; the expensive scoring runs outside it on a snapshot.
+    Exceptions: :class:`PluginConfigurationError` naming the parameter.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.filter = ParticleFilter2D(1)
+        self._lock = threading.Lock()
+        self._throttle = WarningThrottle(period=5.0)
+        self._odom: Odometry | None = None
+        self._odom_used: tuple[float, float, float] | None = None
+        self._odom_used_stamp: float | None = None
+        self._last_reseed = 0.0
+        self._ros: dict = {}
+        self._broadcaster = None
+        self._field_map: SimpleMap | None = None
+        self._field: np.ndarray | None = None
+
+    # -- configuration ------------------------------------------------------------------------
+    def on_initialize(self) -> None:
+        self._destroy_ros()
+        alias = self.plugin_name
+        v = {name: self._number(name, default) for name, default in DEFAULTS.items()}
+        num = v["num_particles"]
+        if num != int(num) or num < 1:
+            raise PluginConfigurationError(f"{alias}.num_particles = {num} must be an integer >= 1")
+        for name in DEFAULTS:
+            if name.startswith(("noise_", "min_noise_", "initial_pose.std")) and v[name] < 0.0:
+                raise PluginConfigurationError(f"{alias}.{name} = {v[name]} must be >= 0")
+        if v["reseed_freq"] <= 0.0:
+            raise PluginConfigurationError(f"{alias}.reseed_freq = {v['reseed_freq']} must be > 0")
+        self.num_particles = int(num)
+        self.reseed_period = 1.0 / v["reseed_freq"]
+        self.noise = (
+            v["noise_translation"],
+            v["noise_rotation"],
+            v["noise_translation_to_rotation"],
+        )
+        self.min_noise_xy = v["min_noise_xy"]
+        self.min_noise_yaw = v["min_noise_yaw"]
+        if v["hit_sigma"] < 0.0:
+            raise PluginConfigurationError(f"{alias}.hit_sigma = {v['hit_sigma']} must be >= 0")
+        self.hit_sigma = v["hit_sigma"]
+        self._field_map = None
+        self._field = None
+        with self._lock:
+            self.filter = ParticleFilter2D(self.num_particles)
+            std_xy = v["initial_pose.std_dev_xy"]
+            self.filter.seed(
+                v["initial_pose.x"],
+                v["initial_pose.y"],
+                v["initial_pose.yaw"],
+                np.eye(2) * std_xy**2,
+                v["initial_pose.std_dev_yaw"],
+            )
+            self._odom = None
+            self._odom_used = None
+            self._odom_used_stamp = None
+        self._last_reseed = self.now()
+        self.logger.info(
+            f"{alias}: {self.num_particles} particles around ({v['initial_pose.x']:g}, "
+            f"{v['initial_pose.y']:g}, {v['initial_pose.yaw']:g}) std "
+            f"[{std_xy:g} m, {v['initial_pose.std_dev_yaw']:g} rad]"
+        )
+        if self.context.node is not None:
+            self._create_ros()
+
+    def on_cleanup(self) -> None:
+        self._destroy_ros()
+
+    def _number(self, name: str, default: float) -> float:
+        value = self.get_parameter(name, default)
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise PluginConfigurationError(
+                f"{self.plugin_name}.{name} = {value!r} is not a number"
+            ) from None
+        if not math.isfinite(value):
+            raise PluginConfigurationError(f"{self.plugin_name}.{name} = {value} is not finite")
+        return value
+
+    # -- inputs -------------------------------------------------------------------------------
+    def set_odometry(self, odometry: Odometry) -> None:
+        """The latest wheel odometry (``odom → robot`` pose). Any thread; non-finite ignored."""
+        if not odometry.is_finite():
+            self._throttle.warn(
+                self.logger, "odom-nan", f"{self.plugin_name}: non-finite odometry ignored"
+            )
+            return
+        self._odom = odometry  # one reference swap: the RT thread reads a whole message
+
+    def reset_pose(
+        self, x: float, y: float, yaw: float, cov_xy: np.ndarray, var_yaw: float
+    ) -> None:
+        """Redraw every particle around ``(x, y, yaw)`` with that covariance (at least the
+        minimum noise). Non-RT side (callbacks); serialised with the RT prediction."""
+        with self._lock:
+            self.filter.seed(
+                x,
+                y,
+                yaw,
+                cov_xy,
+                math.sqrt(max(var_yaw, 0.0)),
+                self.min_noise_xy,
+                self.min_noise_yaw,
+            )
+        self._last_reseed = self.now()
+        self.logger.info(
+            f"{self.plugin_name}: {len(self.filter)} particles reset around "
+            f"({x:.3f}, {y:.3f}, {yaw:.3f})"
+        )
+
+    def on_last_known_pose(self, pose: Odometry) -> None:
+        """Continue from the pose left by the previous localizer (any type)."""
+        cov = np.asarray(pose.pose_covariance, dtype=float).reshape(6, 6)
+        self.reset_pose(pose.pose.x, pose.pose.y, pose.pose.yaw, cov[:2, :2], cov[5, 5])
+
+    # -- prediction (RT) ----------------------------------------------------------------------
+    def update_rt(self, nav_state: NavState) -> None:
+        """Move the particles by the new odometry; write ``robot_pose``; broadcast ``map → odom``.
+
+        The transform is sent once per odometry message (stamped with it), so the TF tree never
+        gets two samples with one stamp; a correction shows in the next one.
+        """
+        odom = self._odom
+        new_odom = odom is not None and odom.header.stamp != self._odom_used_stamp
+        with self._lock:
+            if new_odom:
+                current = _xy_yaw(odom.pose)
+                if self._odom_used is not None:
+                    x0, y0, yaw0 = self._odom_used
+                    c, s = math.cos(yaw0), math.sin(yaw0)
+                    dxw, dyw = current[0] - x0, current[1] - y0
+                    self.filter.predict(
+                        c * dxw + s * dyw,
+                        -s * dxw + c * dyw,
+                        normalize_angle(current[2] - yaw0),
+                        *self.noise,
+                    )
+                self._odom_used = current
+                self._odom_used_stamp = odom.header.stamp
+            estimate = self.filter.estimate()
+            covariance = self.filter.covariance(estimate)
+        self._write_pose(nav_state, estimate, covariance, odom)
+        if new_odom:
+            self._send_map_to_odom(estimate, _xy_yaw(odom.pose), odom.header.stamp)
+
+    # -- correction (non-RT) ------------------------------------------------------------------
+    def update(self, nav_state: NavState) -> None:
+        """Weigh the particles against the map; resample and reseed; write ``robot_pose``."""
+        alias = self.plugin_name
+        if not nav_state.has(MAP_KEY):
+            self._throttle.warn(self.logger, "no-map", f"{alias}: no '{MAP_KEY}' map yet")
+            return
+        grid = nav_state.get(MAP_KEY, SimpleMap)
+        perceptions = nav_state.get_no_group(PointPerception)
+        if not perceptions:
+            self._throttle.warn(self.logger, "no-perceptions", f"{alias}: no point perceptions")
+            return
+        buffer = get_tf_buffer(self.context.namespace)
+        frame = buffer.get_tf_info().robot_footprint_frame
+        points = (
+            PointPerceptionsOps(perceptions, buffer, self.logger)
+            .fuse(frame)
+            .filter((math.nan, math.nan, MIN_POINT_Z), (math.nan, math.nan, math.nan))
+            .collapse((math.nan, math.nan, 0.0))
+            .downsample(grid.resolution)
+            .as_points()
+        )
+        if len(points) == 0:
+            self._throttle.warn(
+                self.logger,
+                "no-points",
+                f"{alias}: no points to correct with (none above z {MIN_POINT_Z} m in {frame})",
+            )
+            return
+        if grid is not self._field_map:  # map.base is replaced, never mutated: cache per object
+            self._field, self._field_map = likelihood_field(grid, self.hit_sigma), grid
+        with self._lock:
+            snapshot = self.filter.poses.copy()
+        fractions, _ = hit_fractions(snapshot, points[:, :2], grid, self._field)
+        now = self.now()
+        with self._lock:
+            if len(self.filter) == len(fractions):  # not reset meanwhile to another size
+                if not self.filter.correct(fractions):
+                    self._throttle.warn(
+                        self.logger,
+                        "no-hits",
+                        f"{alias}: no particle explains the scan (no point hits the map)",
+                    )
+                elif self.filter.effective_sample_size() < 0.5 * len(self.filter):
+                    self.filter.resample()
+            if now - self._last_reseed >= self.reseed_period or now < self._last_reseed:
+                self.filter.reseed_worst_half(self.min_noise_xy, self.min_noise_yaw)
+                self._last_reseed = now
+            estimate = self.filter.estimate()
+            covariance = self.filter.covariance(estimate)
+            poses = self.filter.poses.copy()
+        self._write_pose(nav_state, estimate, covariance, self._odom)
+        self._publish_particles(poses, estimate, covariance)
+
+    # -- outputs ------------------------------------------------------------------------------
+    def _write_pose(
+        self,
+        nav_state: NavState,
+        estimate: tuple[float, float, float],
+        covariance: np.ndarray,
+        odom: Odometry | None,
+    ) -> None:
+        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        x, y, yaw = estimate
+        cov6 = np.zeros((6, 6))
+        cov6[np.ix_((0, 1, 5), (0, 1, 5))] = covariance
+        pose = Odometry(
+            header=Header(odom.header.stamp if odom is not None else self.now(), tf_info.map_frame),
+            child_frame_id=tf_info.robot_footprint_frame,
+            pose=Pose.from_xy_yaw(x, y, yaw),
+            pose_covariance=cov6,
+            twist=odom.twist if odom is not None else Twist(),
+        )
+        nav_state.set(POSE_KEY, pose)
+        nav_state.set(COVARIANCE_TRACE_KEY, float(np.trace(covariance)))
+
+    def _send_map_to_odom(
+        self, estimate: tuple[float, float, float], odom_xy_yaw: tuple, stamp: float
+    ) -> None:
+        # map→odom = (map→robot)·(odom→robot)⁻¹, all planar.
+        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        x, y, yaw = estimate
+        ox, oy, oyaw = odom_xy_yaw
+        t_yaw = normalize_angle(yaw - oyaw)
+        c, s = math.cos(t_yaw), math.sin(t_yaw)
+        tx, ty = x - (c * ox - s * oy), y - (s * ox + c * oy)
+        transform = TransformStamped(
+            Header(stamp, tf_info.map_frame),
+            tf_info.odom_frame,
+            Transform(np.array((tx, ty, 0.0)), np.array(yaw_to_quaternion(t_yaw))),
+        )
+        if self._broadcaster is not None:
+            self._broadcaster.send_transform(transform)
+        else:
+            get_tf_buffer(self.context.namespace).set_transform(transform, self.plugin_name)
+
+    def _publish_particles(self, poses: np.ndarray, estimate, covariance) -> None:
+        particles = self._ros.get("particles")
+        estimate_pub = self._ros.get("pose")
+        if particles is None:
+            return
+        from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped
+
+        from easynav.core.ros.converters import header_to_msg, pose_to_msg
+
+        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        odom = self._odom
+        header = header_to_msg(Header(odom.header.stamp if odom else self.now(), tf_info.map_frame))
+        if particles.get_subscription_count() > 0:
+            msg = PoseArray(header=header)
+            msg.poses = [pose_to_msg(Pose.from_xy_yaw(*p)) for p in poses.tolist()]
+            particles.publish(msg)
+        if estimate_pub.get_subscription_count() > 0:
+            msg = PoseWithCovarianceStamped(header=header)
+            msg.pose.pose = pose_to_msg(Pose.from_xy_yaw(*estimate))
+            cov6 = np.zeros((6, 6))
+            cov6[np.ix_((0, 1, 5), (0, 1, 5))] = covariance
+            msg.pose.covariance = cov6.ravel()
+            estimate_pub.publish(msg)
+
+    # -- ROS ----------------------------------------------------------------------------------
+    def _create_ros(self) -> None:
+        from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped
+        from nav_msgs.msg import Odometry as OdometryMsg
+        from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+        from easynav.core.tf import TFBroadcaster
+
+        node = self.context.node
+        base = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}"
+        # The original's SensorDataQoS().reliable(): keep last 5, reliable, volatile.
+        odom_qos = QoSProfile(
+            history=HistoryPolicy.KEEP_LAST,
+            depth=5,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.VOLATILE,
+        )
+        self._ros = {
+            "odom": node.create_subscription(OdometryMsg, "odom", self._on_odom, odom_qos),
+            "initialpose": node.create_subscription(
+                PoseWithCovarianceStamped, "initialpose", self._on_initial_pose, 10
+            ),
+            "particles": node.create_publisher(PoseArray, f"{base}/particles", 10),
+            "pose": node.create_publisher(PoseWithCovarianceStamped, f"{base}/pose", 10),
+        }
+        self._broadcaster = TFBroadcaster(node, local_buffer=get_tf_buffer(self.context.namespace))
+
+    def _destroy_ros(self) -> None:
+        node = self.context.node
+        ros, self._ros = self._ros, {}
+        broadcaster, self._broadcaster = self._broadcaster, None
+        if node is None:
+            return
+        for name, entity in ros.items():
+            if name in ("odom", "initialpose"):
+                node.destroy_subscription(entity)
+            else:
+                node.destroy_publisher(entity)
+        if broadcaster is not None:
+            broadcaster.destroy()
+
+    def _on_odom(self, msg) -> None:
+        from easynav.core.ros.converters import odometry_from_msg
+
+        self.set_odometry(odometry_from_msg(msg))
+
+    def _on_initial_pose(self, msg) -> None:
+        from easynav.core.ros.converters import pose_from_msg
+
+        map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
+        frame = msg.header.frame_id
+        if frame and frame.lstrip("/") != map_frame:
+            self.logger.warning(
+                f"{self.plugin_name}: initialpose in frame '{frame}' ignored: expected "
+                f"'{map_frame}'"
+            )
+            return
+        pose = pose_from_msg(msg.pose.pose)
+        if not pose.is_finite():
+            self.logger.warning(f"{self.plugin_name}: non-finite initialpose ignored")
+            return
+        cov = np.array(msg.pose.covariance, dtype=float).reshape(6, 6)
+        if not np.all(np.isfinite(cov)):
+            self.logger.warning(f"{self.plugin_name}: initialpose covariance not finite: ignored")
+            return
+        self.reset_pose(pose.x, pose.y, pose.yaw, cov[:2, :2], cov[5, 5])

@@ -1,0 +1,255 @@
+"""ParticleFilter2D: the vectorised particle filter behind the simple AMCL localizer."""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+from easynav.maps import SimpleMap
+
+
+def _wrap(angles: np.ndarray) -> np.ndarray:
+    return (angles + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def likelihood_field(grid: SimpleMap, sigma: float) -> np.ndarray:
+    """How much a point in each cell counts as a hit: ``exp(-d² / 2σ²)`` for a cell whose centre
+    is ``d`` metres from the nearest occupied cell centre (1 on occupied cells); ``sigma`` 0
+    gives exact hits (1 on occupied cells, 0 elsewhere). ``(height, width)`` float32.
+
+    The soft version widens the basin around the true pose: a particle 0.3 m off still scores
+    better than one 1 m off, so the cloud is pulled towards the truth instead of waiting for
+    random samples to land on it.
+    """
+    if not math.isfinite(sigma) or sigma < 0.0:
+        raise ValueError(f"hit sigma = {sigma} must be finite and >= 0")
+    if sigma == 0.0 or not grid.cells.any():
+        return grid.cells.astype(np.float32)
+    free = (~grid.cells).astype(np.uint8)
+    distance = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) * grid.resolution
+    return np.exp(-0.5 * np.square(distance / sigma)).astype(np.float32)
+
+
+def hit_fractions(
+    poses: np.ndarray,
+    points_xy: np.ndarray,
+    grid: SimpleMap,
+    field: np.ndarray | None = None,
+    chunk: int = 128,
+) -> tuple[np.ndarray, np.ndarray]:
+    """For each particle pose ``(x, y, yaw)``: the fraction of ``points_xy`` (robot frame) that
+    hit occupied cells of ``grid``, and how many landed on the map at all.
+
+    ``field`` (from :func:`likelihood_field`) says how much a point in each cell counts as a
+    hit; None counts exact hits on occupied cells (the original's score). A particle whose
+    points all fall off the map scores 0. Vectorised over particles × points, in float32 cell
+    units and ``chunk`` particles at a time, which keeps the intermediate arrays in cache (4–5×
+    faster than one float64 pass for 1000 particles).
+    """
+    n = len(poses)
+    fractions = np.zeros(n)
+    possible = np.zeros(n, dtype=np.int64)
+    if n == 0 or len(points_xy) == 0 or grid.width == 0 or grid.height == 0:
+        return fractions, possible
+    if field is None:
+        field = grid.cells.astype(np.float32)
+    elif field.shape != grid.cells.shape:
+        raise ValueError(f"likelihood field shape {field.shape} != map shape {grid.cells.shape}")
+    inv = 1.0 / grid.resolution
+    px = (points_xy[:, 0] * inv).astype(np.float32)[None, :]
+    py = (points_xy[:, 1] * inv).astype(np.float32)[None, :]
+    ox = ((poses[:, 0] - grid.origin_x) * inv).astype(np.float32)[:, None]
+    oy = ((poses[:, 1] - grid.origin_y) * inv).astype(np.float32)[:, None]
+    c = np.cos(poses[:, 2]).astype(np.float32)[:, None]
+    s = np.sin(poses[:, 2]).astype(np.float32)[:, None]
+    values = np.ascontiguousarray(field, dtype=np.float32).ravel()
+    width, height = grid.width, grid.height
+    for a in range(0, n, chunk):
+        b = min(n, a + chunk)
+        gx = np.floor(ox[a:b] + c[a:b] * px - s[a:b] * py).astype(np.int32)
+        gy = np.floor(oy[a:b] + s[a:b] * px + c[a:b] * py).astype(np.int32)
+        # Negative indices become huge unsigned ones: one comparison per axis checks both ends.
+        inside = (gx.view(np.uint32) < width) & (gy.view(np.uint32) < height)
+        flat = gy * width + gx
+        np.clip(flat, 0, width * height - 1, out=flat)
+        hits = values[flat]
+        hits *= inside
+        count = inside.sum(axis=1)
+        possible[a:b] = count
+        np.divide(hits.sum(axis=1, dtype=np.float64), count, out=fractions[a:b], where=count > 0)
+    return fractions, possible
+
+
+class ParticleFilter2D:
+    """Planar poses ``(x, y, yaw)`` with normalised weights.
+
+    - :meth:`seed`: Gaussian cloud around a pose (full 2×2 position covariance, yaw std).
+    - :meth:`predict`: each particle moves by an odometry increment (expressed in the robot's
+      previous frame) with zero-mean noise of std ``|dx|·noise_translation``,
+      ``|dy|·noise_translation`` and ``|dyaw|·noise_rotation + |d|·noise_translation_to_rotation``
+      (the original's motion model).
+    - :meth:`correct`: weights are multiplied by each particle's likelihood (Bayes' rule).
+    - :meth:`resample`: low-variance (systematic) resampling.
+    - :meth:`reseed_worst_half`: the lower-weight half is redrawn around particles of the upper
+      half, picked by weight, with the upper half's spread (at least ``min_noise_xy`` and
+      ``min_noise_yaw``): the original's way of keeping the cloud alive.
+
+    Thread contract: not locked; the localizer serialises access from its two threads.
+    Exceptions: :class:`ValueError` for a particle count < 1 or non-finite seeds.
+    """
+
+    def __init__(self, num_particles: int, rng: np.random.Generator | None = None) -> None:
+        num_particles = int(num_particles)
+        if num_particles < 1:
+            raise ValueError(f"num_particles = {num_particles} must be >= 1")
+        self.rng = rng if rng is not None else np.random.default_rng()
+        self.poses = np.zeros((num_particles, 3))
+        self.weights = np.full(num_particles, 1.0 / num_particles)
+
+    def __len__(self) -> int:
+        return len(self.poses)
+
+    # -- sampling -----------------------------------------------------------------------------
+    def seed(
+        self,
+        x: float,
+        y: float,
+        yaw: float,
+        cov_xy: np.ndarray,
+        std_yaw: float,
+        min_std_xy: float = 0.0,
+        min_std_yaw: float = 0.0,
+    ) -> None:
+        """Draw every particle around ``(x, y, yaw)``; weights become uniform.
+
+        ``cov_xy`` is a 2×2 covariance (negative eigenvalues are clipped); when its mean std is
+        below ``min_std_xy`` it is scaled up to it, and the yaw std is at least ``min_std_yaw``.
+        """
+        if not all(math.isfinite(v) for v in (x, y, yaw, std_yaw)):
+            raise ValueError(f"seed pose ({x}, {y}, {yaw}) and std_yaw {std_yaw} must be finite")
+        cov = np.asarray(cov_xy, dtype=float).reshape(2, 2)
+        if not np.all(np.isfinite(cov)):
+            raise ValueError(f"seed covariance must be finite, got {cov.tolist()}")
+        cov = 0.5 * (cov + cov.T)
+        eigenvalues, eigenvectors = np.linalg.eigh(cov)
+        eigenvalues = np.clip(eigenvalues, 0.0, None)
+        mean_std = math.sqrt(max(0.5 * eigenvalues.sum(), 0.0))
+        if mean_std < min_std_xy:
+            if mean_std > 1e-9:
+                eigenvalues = eigenvalues * (min_std_xy / mean_std) ** 2
+            else:
+                eigenvalues = np.full(2, min_std_xy**2)
+                eigenvectors = np.eye(2)
+        transform = eigenvectors * np.sqrt(eigenvalues)
+        n = len(self.poses)
+        offsets = self.rng.standard_normal((n, 2)) @ transform.T
+        self.poses[:, 0] = x + offsets[:, 0]
+        self.poses[:, 1] = y + offsets[:, 1]
+        self.poses[:, 2] = _wrap(yaw + max(abs(std_yaw), min_std_yaw) * self.rng.standard_normal(n))
+        self.weights[:] = 1.0 / n
+
+    def predict(
+        self,
+        dx: float,
+        dy: float,
+        dyaw: float,
+        noise_translation: float,
+        noise_rotation: float,
+        noise_translation_to_rotation: float,
+    ) -> None:
+        """Move every particle by the odometry increment ``(dx, dy, dyaw)`` plus noise."""
+        n = len(self.poses)
+        translation = math.hypot(dx, dy)
+        std_yaw = abs(dyaw) * noise_rotation + translation * noise_translation_to_rotation
+        noise = self.rng.standard_normal((n, 3))
+        ndx = dx + noise[:, 0] * abs(dx) * noise_translation
+        ndy = dy + noise[:, 1] * abs(dy) * noise_translation
+        ndyaw = dyaw + noise[:, 2] * std_yaw
+        c, s = np.cos(self.poses[:, 2]), np.sin(self.poses[:, 2])
+        self.poses[:, 0] += c * ndx - s * ndy
+        self.poses[:, 1] += s * ndx + c * ndy
+        self.poses[:, 2] = _wrap(self.poses[:, 2] + ndyaw)
+
+    # -- weighting ----------------------------------------------------------------------------
+    def correct(self, likelihoods: np.ndarray) -> bool:
+        """Multiply the weights by ``likelihoods`` (one per particle, >= 0) and normalise.
+
+        Returns False (weights unchanged) when every product is zero: the measurement explains
+        no particle, and wiping the belief out would be worse than ignoring it.
+        """
+        likelihoods = np.asarray(likelihoods, dtype=float)
+        if likelihoods.shape != self.weights.shape:
+            raise ValueError(
+                f"{likelihoods.shape[0] if likelihoods.ndim else 0} likelihoods for "
+                f"{len(self.weights)} particles"
+            )
+        product = self.weights * np.where(np.isfinite(likelihoods), likelihoods, 0.0)
+        total = product.sum()
+        if not total > 0.0:
+            return False
+        self.weights = product / total
+        return True
+
+    def effective_sample_size(self) -> float:
+        """``1 / Σ w²``: N for uniform weights, 1 when one particle holds them all."""
+        return float(1.0 / np.square(self.weights).sum())
+
+    def resample(self) -> None:
+        """Low-variance resampling: N evenly spaced pointers with one random offset."""
+        n = len(self.poses)
+        positions = (self.rng.random() + np.arange(n)) / n
+        cumulative = np.cumsum(self.weights)
+        cumulative[-1] = 1.0  # guard against round-off
+        indices = np.searchsorted(cumulative, positions, side="right")
+        self.poses = self.poses[np.minimum(indices, n - 1)]
+        self.weights = np.full(n, 1.0 / n)
+
+    def reseed_worst_half(self, min_noise_xy: float, min_noise_yaw: float) -> None:
+        """Redraw the lower-weight half around the upper half (see the class docstring)."""
+        n = len(self.poses)
+        if n < 2:
+            return
+        order = np.argsort(-self.weights, kind="stable")
+        top, worst = order[: n // 2 + n % 2], order[n // 2 + n % 2 :]
+        top_w = self.weights[top] / self.weights[top].sum()
+        mean = top_w @ self.poses[top, :2]
+        d = self.poses[top, :2] - mean
+        cov = (top_w[:, None] * d).T @ d
+        std_xy = max(math.sqrt(max(0.5 * np.trace(cov), 0.0)), min_noise_xy)
+        std_yaw = max(math.sqrt(_circular_variance(self.poses[top, 2], top_w)), min_noise_yaw)
+        positions = (self.rng.random() + np.arange(len(worst))) / len(worst)
+        picks = top[np.minimum(np.searchsorted(np.cumsum(top_w), positions), len(top) - 1)]
+        noise = self.rng.standard_normal((len(worst), 3))
+        self.poses[worst, 0] = self.poses[picks, 0] + std_xy * noise[:, 0]
+        self.poses[worst, 1] = self.poses[picks, 1] + std_xy * noise[:, 1]
+        self.poses[worst, 2] = _wrap(self.poses[picks, 2] + std_yaw * noise[:, 2])
+        self.weights[worst] = self.weights[picks]
+        self.weights /= self.weights.sum()
+
+    # -- estimates ----------------------------------------------------------------------------
+    def estimate(self) -> tuple[float, float, float]:
+        """Weighted mean of the upper-weight half (robust to stray particles), circular for yaw."""
+        n = len(self.poses)
+        top = np.argsort(-self.weights, kind="stable")[: max(1, n // 2)]
+        w = self.weights[top]
+        w = w / w.sum() if w.sum() > 0.0 else np.full(len(top), 1.0 / len(top))
+        x, y = w @ self.poses[top, :2]
+        yaw = math.atan2(w @ np.sin(self.poses[top, 2]), w @ np.cos(self.poses[top, 2]))
+        return float(x), float(y), float(yaw)
+
+    def covariance(self, mean: tuple[float, float, float] | None = None) -> np.ndarray:
+        """3×3 weighted covariance of ``(x, y, yaw)`` over every particle, around ``mean``
+        (default: the weighted mean); yaw differences are wrapped to [-π, π)."""
+        if mean is None:
+            mean = self.estimate()
+        d = self.poses - np.asarray(mean, dtype=float)
+        d[:, 2] = _wrap(d[:, 2])
+        return (self.weights[:, None] * d).T @ d
+
+
+def _circular_variance(angles: np.ndarray, weights: np.ndarray) -> float:
+    """``-2 ln R`` of the weighted mean resultant length R (the original's yaw variance)."""
+    r = math.hypot(weights @ np.cos(angles), weights @ np.sin(angles))
+    return max(0.0, -2.0 * math.log(max(r, 1e-12)))  # r may exceed 1 by round-off

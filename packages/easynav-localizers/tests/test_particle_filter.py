@@ -1,0 +1,140 @@
+"""ParticleFilter2D and hit_fractions: sampling, motion, weighting, resampling, estimates."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from easynav.localizers import ParticleFilter2D, hit_fractions
+from easynav.maps import SimpleMap
+
+
+def filter_with(n=4000, seed=0) -> ParticleFilter2D:
+    return ParticleFilter2D(n, np.random.default_rng(seed))
+
+
+def test_seed_draws_the_requested_gaussian():
+    pf = filter_with()
+    cov = np.array([[0.09, 0.03], [0.03, 0.04]])
+    pf.seed(1.0, -2.0, 3.0, cov, 0.2)
+    assert pf.poses[:, :2].mean(axis=0) == pytest.approx([1.0, -2.0], abs=0.02)
+    assert np.cov(pf.poses[:, :2].T) == pytest.approx(cov, abs=0.01)
+    yaw_dev = np.remainder(pf.poses[:, 2] - 3.0 + np.pi, 2 * np.pi) - np.pi
+    assert yaw_dev.std() == pytest.approx(0.2, abs=0.01)
+    assert np.all(np.abs(pf.poses[:, 2]) <= np.pi)  # wrapped
+    assert pf.weights.sum() == pytest.approx(1.0)
+
+
+def test_seed_enforces_minimum_noise():
+    pf = filter_with()
+    pf.seed(0.0, 0.0, 0.0, np.zeros((2, 2)), 0.0, min_std_xy=0.05, min_std_yaw=0.05)
+    assert pf.poses[:, 0].std() == pytest.approx(0.05, rel=0.1)
+    assert pf.poses[:, 2].std() == pytest.approx(0.05, rel=0.1)
+    with pytest.raises(ValueError, match="must be finite"):
+        pf.seed(float("nan"), 0.0, 0.0, np.eye(2), 0.1)
+
+
+def test_predict_composes_the_increment_in_each_particle_frame():
+    pf = filter_with(2)
+    pf.poses[:] = [[0.0, 0.0, 0.0], [1.0, 1.0, math.pi / 2]]
+    pf.predict(1.0, 0.5, 0.1, 0.0, 0.0, 0.0)
+    assert pf.poses[0] == pytest.approx([1.0, 0.5, 0.1])
+    assert pf.poses[1] == pytest.approx([0.5, 2.0, math.pi / 2 + 0.1])
+
+
+def test_predict_noise_grows_with_motion():
+    pf = filter_with()
+    pf.seed(0.0, 0.0, 0.0, np.zeros((2, 2)), 0.0)
+    pf.predict(0.0, 0.0, 0.0, 0.1, 0.1, 0.1)
+    assert np.all(pf.poses == 0.0)  # no motion, no noise: the original's model
+    pf.predict(1.0, 0.0, 0.5, 0.1, 0.2, 0.1)
+    assert pf.poses[:, 0].std() == pytest.approx(0.1, rel=0.1)
+    assert pf.poses[:, 2].std() == pytest.approx(0.5 * 0.2 + 1.0 * 0.1, rel=0.1)
+
+
+def test_correct_and_low_variance_resampling():
+    pf = filter_with(1000)
+    pf.poses[:, 0] = np.arange(1000) % 4  # four groups
+    likelihood = np.where(pf.poses[:, 0] == 2, 3.0, 1.0)
+    assert pf.correct(likelihood)
+    assert pf.weights[pf.poses[:, 0] == 2].sum() == pytest.approx(0.5)
+    assert pf.effective_sample_size() < 1000
+    pf.resample()
+    counts = np.bincount(pf.poses[:, 0].astype(int), minlength=4)
+    assert counts.tolist() == [167, 167, 500, 166] or abs(counts[2] - 500) <= 1
+    assert np.all(pf.weights == 1e-3)
+
+
+def test_correct_with_no_support_keeps_the_belief():
+    pf = filter_with(10)
+    before = pf.weights.copy()
+    assert not pf.correct(np.zeros(10))
+    assert np.array_equal(pf.weights, before)
+    with pytest.raises(ValueError, match="3 likelihoods for 10 particles"):
+        pf.correct(np.ones(3))
+
+
+def test_reseed_redraws_the_worse_half_near_the_better():
+    pf = filter_with(200)
+    pf.poses[:100] = [5.0, 5.0, 1.0]
+    pf.poses[100:] = [-5.0, -5.0, -1.0]
+    pf.weights[:100], pf.weights[100:] = 0.009, 0.001
+    pf.reseed_worst_half(0.05, 0.05)
+    assert np.all(np.hypot(pf.poses[:, 0] - 5.0, pf.poses[:, 1] - 5.0) < 0.3)
+    assert pf.weights.sum() == pytest.approx(1.0)
+
+
+def test_estimate_uses_circular_yaw_and_covariance_wraps():
+    pf = filter_with(4)
+    pf.poses[:] = [
+        [0, 0, math.pi - 0.1],
+        [0, 0, -math.pi + 0.1],
+        [0, 0, math.pi - 0.1],
+        [0, 0, -math.pi + 0.1],
+    ]
+    x, y, yaw = pf.estimate()
+    assert abs(abs(yaw) - math.pi) < 1e-9
+    assert pf.covariance()[2, 2] == pytest.approx(0.01)
+
+
+def test_hit_fractions_match_a_plain_loop():
+    rng = np.random.default_rng(3)
+    grid = SimpleMap(40, 30, 0.1, -1.0, -2.0, rng.random((30, 40)) < 0.3)
+    poses = np.column_stack(
+        (rng.uniform(-1, 3, 50), rng.uniform(-2, 1, 50), rng.uniform(-4, 4, 50))
+    )
+    points = rng.uniform(-2.0, 2.0, (60, 2))
+    fractions, possible = hit_fractions(poses, points, grid, chunk=7)
+    for i, (x, y, yaw) in enumerate(poses):
+        c, s = math.cos(yaw), math.sin(yaw)
+        wx = x + c * points[:, 0] - s * points[:, 1]
+        wy = y + s * points[:, 0] + c * points[:, 1]
+        inside = grid.contains(wx, wy)
+        assert possible[i] == inside.sum()
+        expected = grid.occupied_at(wx, wy)[inside].mean() if inside.any() else 0.0
+        assert fractions[i] == pytest.approx(expected)
+
+
+def test_bad_particle_count():
+    with pytest.raises(ValueError, match="num_particles = 0"):
+        ParticleFilter2D(0)
+
+
+def test_likelihood_field_counts_near_misses_softly():
+    from easynav.localizers import likelihood_field
+
+    grid = SimpleMap(20, 1, 0.1)
+    grid.cells[0, 10] = True
+    field = likelihood_field(grid, 0.2)
+    assert field[0, 10] == 1.0
+    assert field[0, 12] == pytest.approx(math.exp(-0.5 * (0.2 / 0.2) ** 2), rel=1e-5)
+    assert field[0, 0] < 0.01
+    assert np.array_equal(likelihood_field(grid, 0.0), grid.cells.astype(np.float32))
+    fractions, _ = hit_fractions(
+        np.zeros((1, 3)), np.array([[1.05, 0.05], [1.25, 0.05]]), grid, field
+    )
+    assert fractions[0] == pytest.approx((1.0 + field[0, 12]) / 2)
+    with pytest.raises(ValueError, match="hit sigma = -1"):
+        likelihood_field(grid, -1.0)
