@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
@@ -16,6 +17,26 @@ _EXACT_FLOAT = 2**53
 # (plus a constant, so small clouds in big boxes still qualify); otherwise sorting is cheaper.
 _DENSE_CELLS_PER_POINT = 16
 _DENSE_EXTRA_CELLS = 1 << 16
+_KEEP_TABLE_CELLS = 1 << 24
+
+
+_tables = threading.local()
+
+
+def _zeroed_table(cells: int) -> np.ndarray:
+    """A zeroed int32 table of ``cells`` entries, kept per thread between calls.
+
+    A fresh multi-megabyte table is mapped and zeroed by the kernel page by page on every call
+    (~1000 page faults for a 100k-point cloud); this one is allocated once per thread, and the
+    caller zeroes back only the cells it touched. Tables above 16 Mi cells are not kept.
+    """
+    table = getattr(_tables, "table", None)
+    if table is None or table.shape[0] < cells:
+        table = np.zeros(cells, dtype=np.int32)
+        if cells <= _KEEP_TABLE_CELLS:
+            _tables.table = table
+        return table
+    return table[:cells]
 
 
 def voxel_downsample_indices(points: np.ndarray, resolution: float) -> np.ndarray:
@@ -65,9 +86,12 @@ def voxel_downsample_indices(points: np.ndarray, resolution: float) -> np.ndarra
         # Store n - index and keep the maximum: the first point wins, and the table can start
         # as zeros (calloc: pages the cloud never touches cost nothing).
         rank = np.arange(n, 0, -1, dtype=np.int32)
-        first = np.zeros(cells, dtype=np.int32)
-        np.maximum.at(first, packed, rank)  # unbuffered: correct with repeated voxels
-        return np.flatnonzero(first[packed] == rank)
+        first = _zeroed_table(cells)
+        try:
+            np.maximum.at(first, packed, rank)  # unbuffered: correct with repeated voxels
+            return np.flatnonzero(first[packed] == rank)
+        finally:
+            first[packed] = 0  # leave the table zeroed for the next call of this thread
     # A stable sort keeps equal keys in input order: the first of each run is the first point
     # of that voxel.
     order = np.argsort(packed, kind="stable")
