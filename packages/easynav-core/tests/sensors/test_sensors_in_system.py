@@ -41,8 +41,10 @@ def test_scans_reach_navstate_and_expire_when_the_driver_dies(ros, params_file, 
     p = perception(rt)
     assert p is not None and p.valid and len(p) == 3
     assert wait_for(
-        lambda: rt.nav_state.get_or("diagnostics.sensors", None) is not None
-        and rt.nav_state.get("diagnostics.sensors").level == DiagnosticLevel.OK
+        lambda: (
+            rt.nav_state.get_or("diagnostics.sensors", None) is not None
+            and rt.nav_state.get("diagnostics.sensors").level == DiagnosticLevel.OK
+        )
     )
     # The driver dies: within forget_time (+ a cycle) the scan is no longer valid.
     assert wait_for(lambda: not perception(rt).valid, timeout=2.0)

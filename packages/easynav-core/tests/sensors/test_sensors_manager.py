@@ -13,6 +13,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters
 from easynav.core.sensors import (
     ImuPerception,
+    PerceptionHandler,
     PointPerception,
     SensorsConfigurationError,
     SensorsManager,
@@ -265,3 +266,62 @@ def test_cleanup_erases_keys_and_group_memberships():
     assert nav_state.groups()["rear"] == ("other_key",)
     manager.handle_message("laser1", make_scan([1.0], stamp=clock.now))  # late callback: ignored
     assert not nav_state.has("laser1")
+
+
+# -- plugin handlers --------------------------------------------------------------------------
+class RangeAsPointHandler(PerceptionHandler):
+    """A third-party handler: sensor_msgs/Range -> one point ahead (NaN when out of range)."""
+
+    ros_message_type = "sensor_msgs/msg/Range"
+    perception_type = PointPerception
+
+    def to_perception(self, msg, sensor_id):
+        r = msg.range if msg.min_range <= msg.range <= msg.max_range else math.nan
+        points = np.array([[r, 0.0, 0.0], [r, 0.1, 0.0]])
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        return PointPerception(points=points, frame_id=msg.header.frame_id, stamp=stamp)
+
+
+@pytest.fixture
+def range_plugin(monkeypatch):
+    from easynav.core.sensors import handler_registry
+
+    original = handler_registry.available_handlers
+
+    def with_plugin():
+        return dict(original(), **{"acme/RangeAsPointHandler": RangeAsPointHandler})
+
+    monkeypatch.setattr(handler_registry, "available_handlers", with_plugin)
+
+
+def range_msg(value: float, stamp: float):
+    from sensor_msgs.msg import Range
+    from sensor_test_helpers import ros_time
+
+    msg = Range()
+    msg.header.frame_id = "sonar"
+    msg.header.stamp = ros_time(stamp)
+    msg.min_range, msg.max_range, msg.range = 0.02, 4.0, value
+    return msg
+
+
+def test_plugin_handler_is_found_by_type_and_its_nan_points_never_reach_consumers(
+    range_plugin, caplog
+):
+    params = {"sensors": ["sonar"], "sonar.topic": "/range", "sonar.type": "sensor_msgs/msg/Range"}
+    manager, nav_state, clock = configured(params)
+    assert isinstance(manager.handler("sonar"), RangeAsPointHandler)
+    manager.handle_message("sonar", range_msg(1.5, clock.now))
+    stored = nav_state.get("sonar", PointPerception)
+    np.testing.assert_array_equal(stored.points, [[1.5, 0, 0], [1.5, 0.1, 0]])
+    assert not stored.points.flags.writeable
+    with caplog.at_level(logging.WARNING, logger="easynav.sensors"):
+        manager.handle_message("sonar", range_msg(9.0, clock.now))
+    assert nav_state.get("sonar", PointPerception).points.shape == (0, 3)
+    assert "Sensor 'sonar': dropped 2 points with NaN/inf" in caplog.text
+
+
+def test_plugin_handler_chosen_by_name(range_plugin):
+    params = {"sensors": ["s"], "s.topic": "/r", "s.plugin": "acme/RangeAsPointHandler"}
+    manager, _, _ = configured(params)
+    assert isinstance(manager.handler("s"), RangeAsPointHandler)

@@ -9,10 +9,13 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from easynav.core.nav_state import NavState
 from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
 from easynav.core.sensors.errors import PerceptionConversionError, SensorsConfigurationError
 from easynav.core.sensors.handler_registry import resolve_handler
+from easynav.core.sensors.handlers import LaserScanHandler, PointCloud2Handler
 from easynav.core.sensors.point_perception import PointPerception
 from easynav.core.sensors.point_perceptions_ops import PointPerceptionsOps
 from easynav.core.sensors.sensor_state import SensorState
@@ -26,6 +29,8 @@ DIAGNOSTIC_KEY = f"{DIAGNOSTICS_GROUP}.{DIAGNOSTIC_NAME}"
 HARDWARE_ID = "sensors_node"
 PERCEPTIONS_TOPIC = "~/perceptions"
 SENSOR_QUEUE_DEPTH = 5
+# Handlers whose point output already keeps the PointPerception contract (and is measured).
+_TRUSTED = (LaserScanHandler, PointCloud2Handler)
 
 
 class SensorsManager:
@@ -264,6 +269,10 @@ class SensorsManager:
                 f"handler {type(state.handler).__name__} failed: {type(exc).__name__}: {exc}",
             )
             return
+        if isinstance(perception, PointPerception) and type(state.handler) not in _TRUSTED:
+            perception = self._checked_points(sensor_id, state, perception)
+            if perception is None:
+                return
         now = self._clock()
         age = now - stamp
         fresh = math.isfinite(age) and -self._forget_time <= age <= self._forget_time
@@ -296,6 +305,32 @@ class SensorsManager:
                 self._pending_new.add(sensor_id)
                 if isinstance(perception, PointPerception):
                     self._points_version += 1
+
+    def _checked_points(
+        self, sensor_id: str, state: SensorState, perception: PointPerception
+    ) -> PointPerception | None:
+        # The PointPerception contract (no NaN/inf rows, (N, 3) float64, read-only) is kept by
+        # the built-in converters; a plugin handler's output is checked here.
+        points = np.asarray(perception.points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3:
+            state.rejected += 1
+            self._warn(
+                sensor_id,
+                "shape",
+                f"handler {type(state.handler).__name__} returned points of shape {points.shape}, "
+                "not (N, 3): message rejected",
+            )
+            return None
+        finite = np.isfinite(points).all(axis=1)
+        if not finite.all():
+            dropped = int(points.shape[0] - np.count_nonzero(finite))
+            self._warn(sensor_id, "nan", f"dropped {dropped} points with NaN/inf coordinates")
+            points = points[finite]
+        if points is perception.points and points.flags.writeable:
+            points = points.copy()
+        points.flags.writeable = False
+        perception.points = points
+        return perception
 
     def has_new_data(self) -> bool:
         """True when fresh data arrived that :meth:`cycle_rt` has not reported yet. Any thread."""
