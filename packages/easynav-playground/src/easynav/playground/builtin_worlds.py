@@ -56,7 +56,7 @@ def build_home() -> World:
     c = _Canvas(10.0, 8.0)
     c.outer_walls()
     c.wall_x(4.0, 0.0, 8.0, doors=((1.4, 2.6), (5.6, 6.8)))  # bedrooms | living, kitchen
-    c.wall_y(4.0, 0.0, 4.0, doors=((1.4, 2.6),))  # bedroom 1 | bedroom 2
+    c.wall_y(4.0, 0.0, 4.0, doors=((2.0, 3.2),))  # bedroom 1 | bedroom 2
     c.wall_y(5.0, 4.0, 10.0, doors=((6.4, 7.6),))  # living room | kitchen
     c.fill(6.6, 1.6, 7.6, 2.4)  # living room: table
     c.fill(8.2, 0.1, 9.9, 0.7)  # living room: sofa
@@ -64,8 +64,8 @@ def build_home() -> World:
     c.fill(8.2, 6.2, 9.0, 6.8)  # kitchen: island
     c.fill(0.1, 0.1, 2.0, 1.2)  # bedroom 1: bed
     c.fill(0.1, 3.0, 0.7, 3.9)  # bedroom 1: wardrobe
-    c.fill(0.1, 4.8, 1.6, 6.4)  # bedroom 2: bed
-    c.fill(0.1, 7.3, 1.3, 7.9)  # bedroom 2: desk
+    c.fill(0.1, 5.8, 1.6, 7.9)  # bedroom 2: bed
+    c.fill(2.6, 7.4, 3.9, 7.9)  # bedroom 2: desk
     return World(c.grid, RESOLUTION, 0.0, 0.0, name="home")
 
 

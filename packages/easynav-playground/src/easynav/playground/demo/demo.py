@@ -345,6 +345,7 @@ def _run(
         monitor.command_rate(nav_start, nav_end) if monitor is not None else 0.0,
         rtf,
     )
+    truth.save(Path(record).with_name("run.json"))  # truth + EasyNav's estimates, for analysis
     print(summary.format_table(), file=out)
     if output_png:
         plot_run(

@@ -35,7 +35,7 @@ def plot_run(
 
     min_x, min_y, max_x, max_y = world.bounds
     aspect = (max_y - min_y) / (max_x - min_x)
-    fig = Figure(figsize=(10, max(4.0, min(10 * aspect, 14)) + 0.8), dpi=100)
+    fig = Figure(figsize=(9, max(3.5, min(9 * aspect, 14)) + 0.6), dpi=100)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
     ax.imshow(
@@ -106,5 +106,4 @@ def plot_run(
     if title:
         ax.set_title(title, fontsize=10)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
-    fig.tight_layout()
-    fig.savefig(str(path))
+    fig.savefig(str(path), bbox_inches="tight")
