@@ -17,7 +17,6 @@ Run: .venv/bin/python packages/easynav-core/benchmarks/bench_perception.py [--re
 from __future__ import annotations
 
 import argparse
-import ctypes
 import math
 import resource
 import statistics
@@ -29,6 +28,7 @@ import numpy as np
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.sensors.converters import points_from_point_cloud2
 from easynav.core.sensors.handlers import LaserScanHandler, PointCloud2Handler
+from easynav.core.system.process_tuning import tune_malloc
 from easynav.core.tf import TFBuffer
 
 RESOLUTION = 0.1
@@ -136,24 +136,6 @@ def make_cloud_msg(points: np.ndarray, stamp: float):
     msg.is_bigendian, msg.is_dense = False, True
     msg.data = record.tobytes()
     return msg
-
-
-def tune_malloc() -> bool:
-    """Keep freed large blocks in glibc's heap (no mmap/munmap per 100k-point array).
-
-    Every array of a 100k-point cloud is ~0.8-2.4 MB, above glibc's mmap threshold: each one is
-    mapped and unmapped again, and the kernel zeroes its pages on first touch (page faults,
-    counted as CPU time). Raising M_MMAP_THRESHOLD and M_TRIM_THRESHOLD is a process-wide choice
-    for the EasyNav runtime; here it shows what those faults cost. Returns False off glibc.
-    """
-    try:
-        libc = ctypes.CDLL("libc.so.6")
-        m_trim_threshold, m_mmap_threshold = -1, -3
-        ok = libc.mallopt(m_mmap_threshold, 64 << 20) and libc.mallopt(m_trim_threshold, 256 << 20)
-    except (OSError, AttributeError):
-        print("  mallopt: not available (not glibc)")
-        return False
-    return bool(ok)
 
 
 def numpy_chain_lookup(mats: list[np.ndarray]) -> np.ndarray:

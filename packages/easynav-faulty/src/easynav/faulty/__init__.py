@@ -1,1 +1,3 @@
-"""EasyNav fault-injection plugins (FaultyController, FaultyLocalizer, FaultyPlanner, FaultyMapsManager)."""
+"""EasyNav fault-injection plugins (FaultyController, FaultyLocalizer, FaultyPlanner,
+FaultyMapsManager).
+"""

@@ -16,6 +16,7 @@ from rclpy.signals import SignalHandlerOptions
 
 from easynav.core.nav_state import NavState
 from easynav.core.system.cycle_loop import CycleLoop
+from easynav.core.system.process_tuning import tune_malloc
 from easynav.core.system.system_node import SystemNode
 
 
@@ -54,6 +55,7 @@ class EasyNavRuntime:
         if params_file:
             args += ["--params-file", params_file]
         args += list(ros_args or [])
+        tune_malloc()
         self.context = rclpy.Context()
         rclpy.init(args=args, context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.nav_state = NavState()
