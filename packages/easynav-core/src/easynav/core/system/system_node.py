@@ -19,6 +19,7 @@ from easynav.core.system.maps_manager_node import MapsManagerNode
 from easynav.core.system.node_parameters import NodeParameters
 from easynav.core.system.planner_node import PlannerNode
 from easynav.core.system.recovery_node import RecoveryNode
+from easynav.core.system.runtime_reconfiguration import RuntimeReconfiguration
 from easynav.core.system.sensors_node import SensorsNode
 from easynav.core.system.system_context import SystemContext
 from easynav.core.system.system_requests import SystemRequests
@@ -107,6 +108,8 @@ class SystemNode(LifecycleNode):
         self.extensions: list[Any] = []  # goal manager, safety supervisor: see add_extension
         self.goal_manager = GoalManagerExtension(self)
         self.add_extension(self.goal_manager)
+        self.reconfiguration = RuntimeReconfiguration(self)
+        self.add_extension(self.reconfiguration)
 
     def _ns_key(self) -> str:
         return self.get_namespace().strip("/")
