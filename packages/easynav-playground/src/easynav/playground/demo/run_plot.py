@@ -24,6 +24,7 @@ def plot_run(
     collisions: Sequence[dict] = (),
     obstacles: Sequence[MovingObstacle] = (),
     title: str = "",
+    progress_legend: bool = True,
 ) -> None:
     """Draw the world, moving-obstacle tracks, planned paths, the true and estimated
     trajectories, the waypoints (green reached, red not) and collisions; save as PNG.
@@ -96,8 +97,11 @@ def plot_run(
             ls="none",
             label="collision" if i == 0 else None,
         )
-    ax.plot([], [], marker="o", color="tab:green", ls="none", label="waypoint reached")
-    ax.plot([], [], marker="o", color="tab:red", ls="none", label="waypoint not reached")
+    if progress_legend:
+        ax.plot([], [], marker="o", color="tab:green", ls="none", label="waypoint reached")
+        ax.plot([], [], marker="o", color="tab:red", ls="none", label="waypoint not reached")
+    elif waypoints:
+        ax.plot([], [], marker="o", color="tab:green", ls="none", label="demo waypoint")
     ax.set_xlim(min_x, max_x)
     ax.set_ylim(min_y, max_y)
     ax.set_aspect("equal")
@@ -107,3 +111,27 @@ def plot_run(
         ax.set_title(title, fontsize=10)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.savefig(str(path), bbox_inches="tight")
+
+
+def plot_world(world_spec: str, path: str | Path) -> None:
+    """Draw a world with its start pose, default waypoints and obstacle tracks (no run)."""
+    from easynav.playground.world_description import WorldDescription, load_waypoints
+
+    description = WorldDescription.resolve(world_spec)
+    waypoints = []
+    if description.waypoints_path is not None:
+        waypoints = [
+            WaypointResult(i, *w)
+            for i, w in enumerate(load_waypoints(description.waypoints_path), 1)
+        ]
+    for w in waypoints:
+        w.reached_at = 0.0  # drawn green: these are the demo's stops, not a failed run
+    plot_run(
+        path,
+        description.world,
+        waypoints,
+        description.start_pose,
+        obstacles=description.make_obstacles(),
+        title=f"world '{description.world.name}': start, demo waypoints, moving obstacle tracks",
+        progress_legend=False,
+    )

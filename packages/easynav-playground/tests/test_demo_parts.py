@@ -1,0 +1,144 @@
+"""The demo's pieces without ROS: params derivation, summary figures, the picture, progress."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import pytest
+import yaml
+
+from easynav.playground.demo.demo import DEFAULT_PARAMS, build_parser, run_demo
+from easynav.playground.demo.params_patch import derive_params
+from easynav.playground.demo.progress_line import ProgressLine
+from easynav.playground.demo.run_monitor import compose
+from easynav.playground.demo.run_plot import plot_run
+from easynav.playground.demo.run_summary import RunSummary
+from easynav.playground.demo.waypoint_result import WaypointResult
+from easynav.playground.sim import GroundTruthRecorder
+from easynav.playground.world_description import WorldDescription
+
+
+def test_derived_params_point_the_simple_stack_at_the_world(tmp_path):
+    out = tmp_path / "params.yaml"
+    notes, path_topic = derive_params(DEFAULT_PARAMS, tmp_path / "w.map", (1.0, 2.0, 0.5), out)
+    params = yaml.safe_load(out.read_text())
+    maps = params["maps_manager_node"]["ros__parameters"]["simple"]
+    assert maps["package"] == "" and maps["map_path_file"] == str(tmp_path / "w.map")
+    pose = params["localizer_node"]["ros__parameters"]["simple"]["initial_pose"]
+    assert (pose["x"], pose["y"], pose["yaw"]) == (1.0, 2.0, 0.5)
+    assert all(s["ros__parameters"]["use_sim_time"] is True for s in params.values())
+    assert path_topic == "/planner_node/simple/path"
+    assert any("initial_pose" in n for n in notes)
+
+
+def test_derived_params_handle_flat_keys_and_turn_sim_time_on(tmp_path):
+    source = tmp_path / "flat.yaml"
+    source.write_text(
+        "maps_manager_node:\n  ros__parameters:\n    map_types: [m]\n"
+        "    m.plugin: easynav_simple_maps_manager/SimpleMapsManager\n    m.map_path_file: x.map\n"
+        "planner_node:\n  ros__parameters:\n    use_sim_time: false\n"
+    )
+    out = tmp_path / "out.yaml"
+    notes, path_topic = derive_params(source, tmp_path / "w.map", (0, 0, 0), out)
+    params = yaml.safe_load(out.read_text())
+    assert params["maps_manager_node"]["ros__parameters"]["m.map_path_file"] == str(
+        tmp_path / "w.map"
+    )
+    assert params["planner_node"]["ros__parameters"]["use_sim_time"] is True
+    assert any("planner_node.use_sim_time" in n for n in notes)
+    assert path_topic is None
+
+
+def test_not_a_params_file_is_refused(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("just: text\n")
+    with pytest.raises(ValueError, match="ros__parameters"):
+        derive_params(bad, tmp_path / "w.map", (0, 0, 0), tmp_path / "o.yaml")
+
+
+def make_truth():
+    truth = GroundTruthRecorder()
+    for k in range(101):  # 10 s driving +x at 0.1 m/s
+        truth.record_true(k * 0.1, 0.1 * k * 0.1, 0.0, 0.0)
+        truth.record_clearance(k * 0.1, 0.01 * k, 0.0, 0.5 - 0.001 * k)
+        truth.record_estimate(k * 0.1, 0.01 * k + 0.05, 0.0, 0.0)
+    return truth
+
+
+def test_summary_legs_clearance_and_localisation_error():
+    waypoints = [WaypointResult(1, 0.5, 0.0, 0.0, reached_at=5.0), WaypointResult(2, 2.0, 0.0, 0.0)]
+    summary = RunSummary.compute(waypoints, make_truth(), "TIMEOUT", "", 0.0, 10.0, 20.0)
+    assert waypoints[0].leg_time == pytest.approx(5.0)
+    assert waypoints[0].leg_distance == pytest.approx(0.5)
+    assert waypoints[0].arrival_error == pytest.approx(0.0, abs=1e-9)
+    assert summary.distance_driven == pytest.approx(1.0)
+    assert summary.min_clearance == pytest.approx(0.4)
+    assert summary.localisation_mean == pytest.approx(0.05)
+    assert not summary.all_reached and not summary.success
+    table = summary.format_table()
+    assert "NO" in table and "1 of 2" in table and "FAILURE" in table and "20.0 Hz" in table
+
+
+def test_summary_success_needs_every_waypoint_and_no_collision():
+    truth = make_truth()
+    waypoints = [WaypointResult(1, 0.5, 0.0, 0.0, reached_at=5.0)]
+    ok = RunSummary.compute(waypoints, truth, "NAVIGATION_FINISHED", "", 0.0, 10.0, 20.0)
+    assert ok.success and "SUCCESS" in ok.format_table()
+    truth.record_collision({"stamp": 3.0, "x": 0.3, "y": 0.0, "with": "wall"})
+    hit = RunSummary.compute(waypoints, truth, "NAVIGATION_FINISHED", "", 0.0, 10.0, 20.0)
+    assert not hit.success and "collision with wall" in hit.format_table()
+
+
+def test_picture_of_a_run_is_written(tmp_path):
+    import numpy as np
+
+    home = WorldDescription.resolve("home")
+    truth = make_truth()
+    out = tmp_path / "run.png"
+    plot_run(
+        out,
+        home.world,
+        [WaypointResult(1, 5.6, 6.4, 1.57, reached_at=3.0), WaypointResult(2, 2.4, 5.0, 3.14)],
+        home.start_pose,
+        truth.true_poses,
+        truth.estimated_poses,
+        [np.array([(5.6, 3.4), (5.6, 6.4)])],
+        [{"stamp": 1.0, "x": 5.0, "y": 5.0, "with": "wall"}],
+        home.make_obstacles(),
+        title="test",
+    )
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_progress_line_redraws_on_a_terminal_and_prints_lines_otherwise():
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty = Tty()
+    line = ProgressLine(tty)
+    line.show("waypoint 1 of 4", force=True)
+    line.show("wp 2", force=True)
+    line.finish()
+    assert tty.getvalue() == "\rwaypoint 1 of 4\rwp 2           \n"
+    pipe = io.StringIO()
+    line = ProgressLine(pipe, period=100.0)
+    line.show("a", force=True)
+    line.show("b")  # too soon: skipped
+    assert pipe.getvalue() == "a\n"
+
+
+def test_pose_composition():
+    x, y, yaw = compose((1.0, 2.0, math.pi / 2), (1.0, 0.0, 0.1))
+    assert (x, y, yaw) == pytest.approx((1.0, 3.0, math.pi / 2 + 0.1))
+
+
+def test_bad_demo_arguments_exit_2_naming_the_problem(tmp_path, capsys):
+    assert run_demo(world="atlantis", output_png=None) == 2
+    assert "atlantis" in capsys.readouterr().err
+    bad = tmp_path / "w.yaml"
+    bad.write_text("waypoints: [[1, 2]]\n")
+    assert run_demo(world="home", waypoints=bad, output_png=None) == 2
+    assert "waypoint 0" in capsys.readouterr().err
+    assert build_parser().parse_args(["--speed-up", "2"]).speed_up == 2.0
