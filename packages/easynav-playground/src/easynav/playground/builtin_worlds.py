@@ -2,8 +2,9 @@
 
 The shipped ``worlds/<name>.map`` files are these grids saved (regenerate them with
 ``python -m easynav.playground.builtin_worlds``; a test checks that they match). Walls and
-doors sit on multiples of 0.2 m and doors are 1.2 m wide, so that SimplePlanner's 0.2 m grid
-with a 0.3 m robot plus 0.2 m clearance passes through every door.
+doors sit on multiples of 0.2 m and doors are 1.6 m wide in the house (1.2 m, the least
+that SimplePlanner's 0.2 m grid with a 0.3 m robot plus 0.2 m clearance passes, in the office),
+so that the simple stack has some room to spare.
 """
 
 from __future__ import annotations
@@ -55,9 +56,9 @@ def build_home() -> World:
     """A 10 x 8 m house: living room, kitchen, two bedrooms, furniture; 0.05 m cells."""
     c = _Canvas(10.0, 8.0)
     c.outer_walls()
-    c.wall_x(4.0, 0.0, 8.0, doors=((1.4, 2.6), (5.6, 6.8)))  # bedrooms | living, kitchen
-    c.wall_y(4.0, 0.0, 4.0, doors=((2.0, 3.2),))  # bedroom 1 | bedroom 2
-    c.wall_y(5.0, 4.0, 10.0, doors=((6.4, 7.6),))  # living room | kitchen
+    c.wall_x(4.0, 0.0, 8.0, doors=((1.2, 2.8), (5.6, 7.2)))  # bedrooms | living, kitchen
+    c.wall_y(4.0, 0.0, 4.0, doors=((2.0, 3.6),))  # bedroom 1 | bedroom 2
+    c.wall_y(5.0, 4.0, 10.0, doors=((6.2, 7.8),))  # living room | kitchen
     c.fill(6.6, 1.6, 7.6, 2.4)  # living room: table
     c.fill(8.2, 0.1, 9.9, 0.7)  # living room: sofa
     c.fill(4.1, 7.4, 7.0, 7.9)  # kitchen: counter
