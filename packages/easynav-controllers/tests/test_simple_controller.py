@@ -126,3 +126,22 @@ def test_deprecated_limits_still_cap_the_command():
 def test_bad_parameters_fail_configuration(params, message):
     with pytest.raises(PluginConfigurationError, match=message):
         make_controller(params)
+
+
+def test_runs_within_one_clock_tick_keep_the_command():
+    clock = Clock()
+    controller = make_controller({"look_ahead_dist": 0.5}, clock=clock)
+    nav_state = NavState()
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    nav_state.set("path", Path.from_xy_yaw(np.array([[0.0, 0.0, 0.0], [3.0, 0.0, 0.0]])))
+    for _ in range(10):
+        clock.t += 0.05
+        controller.update_rt(nav_state)
+    moving = nav_state.get("cmd_vel", TwistStamped)
+    assert moving.twist.vx > 0.1
+    controller.update_rt(nav_state)  # triggered again at the same simulated time
+    assert nav_state.get("cmd_vel", TwistStamped) is moving
+    clock.t -= 10.0  # the simulation restarted
+    controller.update_rt(nav_state)
+    again = nav_state.get("cmd_vel", TwistStamped)
+    assert again is not moving and again.header.stamp == clock.t

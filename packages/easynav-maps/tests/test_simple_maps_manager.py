@@ -139,3 +139,29 @@ def test_reinitialising_the_same_plugin_reloads():
     )
     manager.initialize(context, "simple")
     assert manager.static_map.width == 120
+
+
+@pytest.mark.parametrize(("tolerance", "marked"), [(0.1, 1), (0.0, 2)])
+def test_points_on_static_walls_are_not_marked_again(tolerance, marked):
+    # empty_room: the east wall's inner face is at x = 2.9.
+    manager = make_manager(
+        {
+            "package": "easynav_maps",
+            "map_path_file": "worlds/empty_room.map",
+            "static_obstacle_tolerance": tolerance,
+        }
+    )
+    laser_at(manager, 0.0, 0.0, 0.3)
+    nav_state = NavState()
+    # One point 4 cm in front of the wall (range noise), one a real obstacle 0.5 m from it.
+    points = np.array([[2.86, 0.0, 0.0], [2.4, 1.0, 0.0]])
+    nav_state.set("laser1", PointPerception(points, "laser", 1.0))
+    manager.update(nav_state)
+    base, live = nav_state.get("map.base", SimpleMap), nav_state.get("map", SimpleMap)
+    assert int(live.cells.sum()) - int(base.cells.sum()) == marked
+    assert live.occupied_at(2.4, 1.0)
+
+
+def test_bad_tolerance_is_refused():
+    with pytest.raises(PluginConfigurationError, match="static_obstacle_tolerance = -1"):
+        make_manager({"static_obstacle_tolerance": -1.0})

@@ -70,7 +70,7 @@ def test_plans_through_the_door_to_the_goal_pose():
     nav_state = state_with((7.0, 1.0, 1.5))
     planner.update(nav_state)
     path = nav_state.get("path", Path)
-    assert path.header.frame_id == "map" and path.header.stamp == 5.0
+    assert path.header.frame_id == "map" and path.header.stamp == 7.0
     xy_yaw = path.as_xy_yaw()
     assert xy_yaw[0, :2].tolist() == [1.0, 1.0]
     assert xy_yaw[-1].tolist() == pytest.approx([7.0, 1.0, 1.5])

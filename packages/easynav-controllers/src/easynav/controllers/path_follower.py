@@ -99,6 +99,7 @@ class SimplePathFollower:
         self._w = 0.0
         self._goal: tuple[float, float, float] | None = None
         self._final_rotation = False
+        self._state = NO_PATH
 
     def reset(self) -> None:
         """Forget the PID state, the last command and the final-rotation mode."""
@@ -107,6 +108,7 @@ class SimplePathFollower:
         self._v = self._w = 0.0
         self._goal = None
         self._final_rotation = False
+        self._state = NO_PATH
 
     def compute(
         self,
@@ -128,6 +130,10 @@ class SimplePathFollower:
         if path.ndim != 2 or len(path) == 0:
             self.reset()
             return 0.0, 0.0, NO_PATH
+        if not dt > 0.0:
+            # No time has passed (several runs within one tick of a simulated clock): the PIDs
+            # cannot differentiate or integrate, so the last command stands.
+            return self._v, self._w, self._state
         x, y, yaw = (float(v) for v in pose_xy_yaw)
         goal = (float(path[-1, 0]), float(path[-1, 1]), float(path[-1, 2]))
         if (
@@ -147,6 +153,7 @@ class SimplePathFollower:
             if abs(yaw_error) <= stop_yaw:
                 self.angular_pid.reset()
                 self._v = self._w = 0.0
+                self._state = ARRIVED
                 return 0.0, 0.0, ARRIVED
             v_target = 0.0
             w_target = self.angular_pid.output(yaw_error, dt)
@@ -168,12 +175,11 @@ class SimplePathFollower:
         v_target = min(v_target, max(limits.max_linear_vel, 0.0))
         w_max = max(limits.max_angular_vel, 0.0)
         w_target = min(max(w_target, -w_max), w_max)
-        if dt > 0.0:
-            v_target = _limit_change(
-                v_target, self._v, limits.max_linear_acc, limits.max_linear_decel, dt
-            )
-            w_target = _limit_change(
-                w_target, self._w, limits.max_angular_acc, limits.max_angular_decel, dt
-            )
-        self._v, self._w = v_target, w_target
+        v_target = _limit_change(
+            v_target, self._v, limits.max_linear_acc, limits.max_linear_decel, dt
+        )
+        w_target = _limit_change(
+            w_target, self._w, limits.max_angular_acc, limits.max_angular_decel, dt
+        )
+        self._v, self._w, self._state = v_target, w_target, state
         return v_target, w_target, state

@@ -121,15 +121,23 @@ class SimpleController(ControllerMethodBase):
         """Compute and write ``cmd_vel``. RT thread."""
         now = self.now()
         dt = 1.0 / self.rt_freq if self._last_time is None else now - self._last_time
-        self._last_time = now
         frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
         path = nav_state.get("path", Path) if nav_state.has("path") else None
         robot = nav_state.get("robot_pose", Odometry) if nav_state.has("robot_pose") else None
         if path is None or len(path) == 0 or robot is None or not robot.is_finite():
+            self._last_time = now
             self.follower.reset()
             self.state = "no_path" if robot is not None and robot.is_finite() else "no_pose"
             nav_state.set("cmd_vel", TwistStamped(Header(now, frame), Twist()))
             return
+        if dt == 0.0:
+            # Triggered again within one tick of the (simulated) clock: nothing new to say; the
+            # previous command stands (the velocity mux keeps its target).
+            return
+        if dt < 0.0:  # the clock went back (a simulation restarted): start afresh
+            self.follower.reset()
+            dt = 1.0 / self.rt_freq
+        self._last_time = now
         if path is not self._path:  # the planner stores a new Path for each plan
             self._path, self._path_xy_yaw = path, path.as_xy_yaw()
         v, w, self.state = self.follower.compute(

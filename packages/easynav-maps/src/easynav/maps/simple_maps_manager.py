@@ -5,6 +5,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import cv2
+import numpy as np
+
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import MapsManagerBase, PluginConfigurationError
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
@@ -21,18 +24,33 @@ OBSTACLE_MIN_Z = 0.1
 DEFAULT_SAVE_PATH = "/tmp/default.map"
 
 
+def near_obstacles(world: SimpleMap, distance: float) -> np.ndarray:
+    """``(height, width)`` bool: cells whose centre is within ``distance`` of an occupied one."""
+    radius = int(math.floor(distance / world.resolution + 1e-9))
+    if radius <= 0 or not world.cells.any():
+        return world.cells.copy()
+    offsets = np.arange(-radius, radius + 1)
+    disc = np.hypot(*np.meshgrid(offsets, offsets)) <= distance / world.resolution + 1e-9
+    return cv2.dilate(world.cells.astype(np.uint8), disc.astype(np.uint8)).astype(bool)
+
+
 class SimpleMapsManager(MapsManagerBase):
     """Loads a :class:`SimpleMap` and keeps a copy with the live obstacles.
 
     Parameters (under ``<alias>.``): ``package`` and ``map_path_file`` (see
     :func:`easynav.maps.resolve_map_file`; with ``package`` empty, ``map_path_file`` is a path;
     a ``.yaml`` file is loaded as a ROS map_server map), ``save_map_path`` (where ``savemap``
-    writes; empty: the loaded file when it was given as a plain path, else ``/tmp/default.map``).
+    writes; empty: the loaded file when it was given as a plain path, else ``/tmp/default.map``),
+    ``static_obstacle_tolerance`` (0.1 m: a point this close to an occupied cell of the static
+    map is that obstacle seen with localisation and range noise, and is not marked again; the
+    original marked it, thickening walls by a cell, which on the planner's coarse grid can close
+    a door; 0 marks every point).
     With neither ``package`` nor ``map_path_file`` set, no map is loaded and the manager waits for
     one on ``incoming_map``.
 
     NavState: reads every ungrouped :class:`PointPerception`; writes ``map.base`` (the static map),
-    ``map`` (a copy with every fused point above z 0.1 m in the map frame marked occupied) and
+    ``map`` (a copy with every fused point above z 0.1 m in the map frame marked occupied, except
+    those explained by the static map, see ``static_obstacle_tolerance``) and
     ``map_time`` (node time of that update, s).
 
     ROS (when hosted by a node; skipped with ``node`` None): publishes ``<fqn>/<alias>/map``
@@ -55,6 +73,9 @@ class SimpleMapsManager(MapsManagerBase):
         self._save_path = DEFAULT_SAVE_PATH
         self._throttle = WarningThrottle(period=5.0)
         self._ros: dict = {}
+        self._tolerance = 0.1
+        self._explained_for: SimpleMap | None = None
+        self._explained: np.ndarray | None = None
 
     # -- configuration --------------------------------------------------------------------------
     def on_initialize(self) -> None:
@@ -67,6 +88,21 @@ class SimpleMapsManager(MapsManagerBase):
         save_map_path = str(
             self.get_parameter("save_map_path", "", "where savemap writes the map (.map)")
         )
+        tolerance = self.get_parameter(
+            "static_obstacle_tolerance", 0.1, "points this close to the static map are not marked"
+        )
+        try:
+            tolerance = float(tolerance)
+        except (TypeError, ValueError):
+            raise PluginConfigurationError(
+                f"{alias}.static_obstacle_tolerance = {tolerance!r} is not a number"
+            ) from None
+        if not math.isfinite(tolerance) or tolerance < 0.0:
+            raise PluginConfigurationError(
+                f"{alias}.static_obstacle_tolerance = {tolerance} must be finite and >= 0"
+            )
+        self._tolerance = tolerance
+        self._explained_for = None
         self._static_map = None
         self._map_file = None
         if package or map_path_file:
@@ -157,7 +193,14 @@ class SimpleMapsManager(MapsManagerBase):
                 .as_points()
             )
             if len(points):
-                dynamic.mark_occupied(points[:, 0], points[:, 1])
+                if static is not self._explained_for:  # replaced, never mutated: cache per map
+                    self._explained = near_obstacles(static, self._tolerance)
+                    self._explained_for = static
+                ix, iy = static.world_to_cell(points[:, 0], points[:, 1])
+                inside = static.cells_in_bounds(ix, iy)
+                ix, iy = ix[inside], iy[inside]
+                new = ~self._explained[iy, ix]
+                dynamic.cells[iy[new], ix[new]] = True
         else:
             self._throttle.warn(
                 self.logger, "no-perceptions", f"{self.plugin_name}: no point perceptions"

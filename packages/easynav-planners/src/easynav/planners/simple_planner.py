@@ -36,8 +36,8 @@ class SimplePlanner(PlannerMethodBase):
     ``diagnostics.path`` (hardware id ``planner``: OK with the path length, WARN naming the goal
     and the reason when there is no path), written when it changes.
 
-    A goal must be in the map frame (an empty frame id counts as the map frame); the path stamp
-    is the newer of the robot pose's and the goal's.
+    A goal must be in the map frame (an empty frame id counts as the map frame); the path is
+    stamped with the node clock at planning time.
 
     ROS (when hosted by a node): publishes ``<fqn>/<alias>/path`` (nav_msgs/Path) while
     subscribed.
@@ -162,8 +162,9 @@ class SimplePlanner(PlannerMethodBase):
         if not result.ok:
             self._fail(nav_state, map_frame, result.reason)
             return
-        stamp = max(robot.header.stamp, goal.header.stamp)
-        path = Path.from_xy_yaw(result.poses, Header(stamp, map_frame))
+        # Stamped with the planning time on the node clock (the original took the newer of the
+        # pose and goal stamps, which is a wall-clock time when a goal client ignores sim time).
+        path = Path.from_xy_yaw(result.poses, Header(self.now(), map_frame))
         self._write(nav_state, path, None, f"path of {result.length:.2f} m to {goal_text}")
 
     def _fail(self, nav_state: NavState, map_frame: str, reason: str) -> None:
