@@ -66,6 +66,7 @@ class EasyNavRuntime:
         self.rt_executor = SingleThreadedExecutor(context=self.context)
         self.nort_executor = SingleThreadedExecutor(context=self.context)
         self.rt_executor.add_node(self.system_node.sensors_node)
+        self.rt_executor.add_node(self.system_node.rt_io_node)
         for node in self.system_node.all_nodes():
             if node is not self.system_node.sensors_node:
                 self.nort_executor.add_node(node)
@@ -180,7 +181,7 @@ class EasyNavRuntime:
                 loop.join(timeout=2.0)
         self.rt_executor.shutdown()
         self.nort_executor.shutdown()
-        for n in node.all_nodes():
+        for n in [*node.all_nodes(), node.rt_io_node]:
             n.destroy_node()
         if self.context.ok():
             rclpy.shutdown(context=self.context)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from easynav.core.sensors import SensorsManager
 from easynav.core.system.component_node import ComponentNode
-from easynav.core.tf import TFListener
 
 
 class SensorsNode(ComponentNode):
@@ -21,8 +20,6 @@ class SensorsNode(ComponentNode):
     def __init__(self, namespace, system, **kwargs):
         super().__init__("sensors_node", namespace, system, **kwargs)
         self.manager: SensorsManager | None = None
-        # TF is received on the RT side, like the sensors whose points it places.
-        self.tf_listener = TFListener(self)
 
     def load_plugins(self) -> None:
         # Perception handlers are chosen per sensor by the manager, not listed as plugins.

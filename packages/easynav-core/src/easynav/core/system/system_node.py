@@ -7,6 +7,7 @@ import threading
 from typing import Any
 
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
+from rclpy.node import Node
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import String
 
@@ -20,10 +21,11 @@ from easynav.core.system.node_parameters import NodeParameters
 from easynav.core.system.planner_node import PlannerNode
 from easynav.core.system.recovery_node import RecoveryNode
 from easynav.core.system.runtime_reconfiguration import RuntimeReconfiguration
+from easynav.core.system.safety_supervisor import SafetySupervisor
 from easynav.core.system.sensors_node import SensorsNode
 from easynav.core.system.system_context import SystemContext
 from easynav.core.system.system_requests import SystemRequests
-from easynav.core.tf import TFInfo, get_tf_buffer
+from easynav.core.tf import TFInfo, TFListener, get_tf_buffer
 
 #: Parameters of system_node and their defaults (REFERENCE.md §1).
 SYSTEM_DEFAULTS: dict[str, Any] = {
@@ -110,6 +112,12 @@ class SystemNode(LifecycleNode):
         self.add_extension(self.goal_manager)
         self.reconfiguration = RuntimeReconfiguration(self)
         self.add_extension(self.reconfiguration)
+        # A hidden companion node spun by the RT loop: what system_node receives on the RT side
+        # (the safety channel's status, TF). rclpy serves a node from one executor only.
+        self.rt_io_node = Node("_system_node_rt", namespace=namespace, **kwargs)
+        self.tf_listener = TFListener(self.rt_io_node)
+        self.safety = SafetySupervisor(self, self.rt_io_node)
+        self.add_extension(self.safety)
 
     def _ns_key(self) -> str:
         return self.get_namespace().strip("/")
@@ -218,6 +226,7 @@ class SystemNode(LifecycleNode):
 
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
         self.error_message = ""
+        self._call_extensions("before_configure")
         try:
             self.read_parameters()
         except Exception as exc:
@@ -312,6 +321,10 @@ class SystemNode(LifecycleNode):
             localizer_ran = self.localizer_node.cycle_rt(new_data)
             self.controller_node.cycle_rt(new_data or localizer_ran)
             self.recovery_node.cycle_rt()
+            for ext in self.extensions:
+                hook = getattr(ext, "cycle_rt_before_publish", None)
+                if hook is not None:
+                    hook()
             self.controller_node.publish_cycle()
             for ext in self.extensions:
                 hook = getattr(ext, "cycle_rt_end", None)
