@@ -275,3 +275,11 @@ def test_sources_are_reported_by_name():
         "pause",
         "controller",
     }
+
+
+def test_proposals_of_the_wrong_type_name_the_source():
+    out = VelocityOutput(LIMITS, 0.5, 0.0)
+    with pytest.raises(TypeError, match="cmd_vel must be a TwistStamped"):
+        out.cycle(1.0, Twist(vx=0.1), None, None, False, None, False)
+    with pytest.raises(TypeError, match="override proposal must be a Twist"):
+        out.cycle(1.0, None, None, (0.0, 0.0), False, None, False)

@@ -64,10 +64,16 @@ class CommandGuard:
     def is_new_controller_command(self, command: TwistStamped | None) -> bool:
         """True when ``command`` differs (stamp or value) from the last one seen; records it.
 
-        None (nothing in NavState ``cmd_vel``) is never new.
+        None (nothing in NavState ``cmd_vel``) is never new. Raises ``TypeError`` for anything
+        but a TwistStamped.
         """
         if command is None:
             return False
+        if not isinstance(command, TwistStamped):
+            raise TypeError(
+                f"NavState cmd_vel must be a TwistStamped (stamp each new command), "
+                f"got {type(command).__name__}"
+            )
         t = command.twist
         values = (t.vx, t.vy, t.vz, t.wx, t.wy, t.wz)
         stamp = command.header.stamp

@@ -64,7 +64,15 @@ class VelocityMux:
         ``controller`` is the controller's command only when it is new (else None);
         ``takeover``/``override`` are the recovery system's proposals of this cycle (or None).
         Never raises on bad velocities: non-finite proposals are discarded and reported.
+        Raises ``TypeError`` naming the source when a proposal is not a Twist.
         """
+        for name, proposal in (
+            ("controller", controller),
+            ("takeover", takeover),
+            ("override", override),
+        ):
+            if proposal is not None and not isinstance(proposal, Twist):
+                raise TypeError(f"{name} proposal must be a Twist, got {type(proposal).__name__}")
         discarded = _NO_DISCARD
         if override is not None and not override.is_finite():
             discarded += (VelocitySource.OVERRIDE,)
