@@ -1,0 +1,71 @@
+"""The seed's simple.params.yaml section for this package loads its plugin unchanged."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+import yaml
+
+from easynav.core.plugins import PluginContext
+from easynav.core.plugins.discovery import load_plugin_class
+from easynav.core.plugins.plugin_kinds import LOCALIZER
+
+pytestmark = pytest.mark.ros
+
+# Verbatim from seed-design.txt (the Kobuki playground's simple.params.yaml, simplified).
+SEED = """
+localizer_node:
+  ros__parameters:
+    use_sim_time: true
+    localizer_types: [simple]
+    simple:
+      rt_freq: 50.0
+      freq: 5.0
+      reseed_freq: 1.0
+      plugin: easynav_simple_localizer/AMCLLocalizer
+      num_particles: 100
+      noise_translation: 0.05
+      noise_rotation: 0.1
+      noise_translation_to_rotation: 0.1
+      initial_pose:
+        x: 0.0
+        y: 0.0
+        yaw: 0.0
+        std_dev_xy: 0.1
+        std_dev_yaw: 0.01
+"""
+
+
+def test_seed_section_configures_the_plugin_through_ros_parameters(tmp_path):
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "OFF"
+    rclpy = pytest.importorskip("rclpy")
+    from easynav.core.system.node_parameters import NodeParameters
+
+    params_file = tmp_path / "simple.params.yaml"
+    params_file.write_text(SEED)
+    section = yaml.safe_load(SEED)["localizer_node"]["ros__parameters"]
+    assert section["localizer_types"] == ["simple"]
+    context = rclpy.Context()
+    rclpy.init(args=["--ros-args", "--params-file", str(params_file)], context=context)
+    try:
+        node = rclpy.create_node("localizer_node", context=context)
+        cls = load_plugin_class(
+            LOCALIZER, section["simple"]["plugin"], "localizer_node.simple.plugin"
+        )
+        plugin = cls()
+        plugin.initialize(
+            PluginContext(
+                parameters=NodeParameters(node), node=None, namespace="seed_localizer_node"
+            ),
+            "simple",
+        )
+        assert (plugin.rt_freq, plugin.freq) == (50.0, 5.0)
+        assert plugin.reseed_period == 1.0
+        assert len(plugin.filter) == 100
+        assert plugin.noise == (0.05, 0.1, 0.1)
+        assert plugin.filter.poses[:, :2].std(axis=0).max() < 0.2  # std_dev_xy 0.1
+        assert plugin.min_noise_yaw == 0.05
+        node.destroy_node()
+    finally:
+        rclpy.shutdown(context=context)
