@@ -1,6 +1,6 @@
 """SimplePathFollower drives a simulated unicycle along an S-shaped path.
 
-    python packages/easynav-controllers/examples/follow_path.py [output.png]
+python packages/easynav-controllers/examples/follow_path.py [output.png]
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """SimplePlanner's algorithm on the shipped house: danger levels, raw and smoothed paths.
 
-    python packages/easynav-planners/examples/plan_in_house.py [output.png]
+python packages/easynav-planners/examples/plan_in_house.py [output.png]
 """
 
 from __future__ import annotations
