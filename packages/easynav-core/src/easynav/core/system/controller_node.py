@@ -102,8 +102,12 @@ class ControllerNode(ComponentNode):
                     f"the controller's period ({lp.alias}.rt_freq = {lp.plugin.rt_freq:g} Hz, "
                     f"{period:g} s)"
                 )
+        # dt is clamped per cycle; allow two RT periods so slow cycles still ramp at full rate.
         self.velocity_output = VelocityOutput(
-            self.robot_limits, self.cmd_timeout, self.keepalive_period
+            self.robot_limits,
+            self.cmd_timeout,
+            self.keepalive_period,
+            max_dt=max(0.1, 2.0 / self.system.system_rt_freq),
         )
         self._create_publisher()
 
