@@ -111,6 +111,8 @@ class AMCLLocalizer(LocalizerMethodBase):
         self._broadcaster = None
         self._field_map: SimpleMap | None = None
         self._field: np.ndarray | None = None
+        # Bumped whenever the cloud is redrawn, so a correction scored on the old cloud is dropped.
+        self._generation = 0
 
     # -- configuration ------------------------------------------------------------------------
     def on_initialize(self) -> None:
@@ -140,6 +142,7 @@ class AMCLLocalizer(LocalizerMethodBase):
         self._field_map = None
         self._field = None
         with self._lock:
+            self._generation += 1
             self.filter = ParticleFilter2D(self.num_particles)
             std_xy = v["initial_pose.std_dev_xy"]
             self.filter.seed(
@@ -192,6 +195,7 @@ class AMCLLocalizer(LocalizerMethodBase):
         """Redraw every particle around ``(x, y, yaw)`` with that covariance (at least the
         minimum noise). Non-RT side (callbacks); serialised with the RT prediction."""
         with self._lock:
+            self._generation += 1
             self.filter.seed(
                 x,
                 y,
@@ -275,10 +279,11 @@ class AMCLLocalizer(LocalizerMethodBase):
             self._field, self._field_map = likelihood_field(grid, self.hit_sigma), grid
         with self._lock:
             snapshot = self.filter.poses.copy()
+            generation = self._generation
         fractions, _ = hit_fractions(snapshot, points[:, :2], grid, self._field)
         now = self.now()
         with self._lock:
-            if len(self.filter) == len(fractions):  # not reset meanwhile to another size
+            if generation == self._generation:  # not redrawn (initialpose) while scoring
                 if not self.filter.correct(fractions):
                     self._throttle.warn(
                         self.logger,
