@@ -160,6 +160,10 @@ COMMANDS = {
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # `goal` and `demo` own their options (including -h): hand them everything after the word.
+    if argv and argv[0] in ("goal", "demo"):
+        return COMMANDS[argv[0]](argparse.Namespace(command=argv[0], args=argv[1:]))
     args = build_parser().parse_args(argv)
     return COMMANDS[args.command](args)
 
