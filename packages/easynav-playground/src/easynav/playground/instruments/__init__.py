@@ -1,0 +1,1 @@
+"""Measuring instruments: plugins that make EasyNav's reactions observable from outside."""
