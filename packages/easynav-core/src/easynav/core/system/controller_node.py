@@ -64,6 +64,7 @@ class ControllerNode(ComponentNode):
         self.forced_use_stamped: bool | None = None
         self.last_published = Twist()
         self.published_any = False
+        self.last_publish_monotonic: float | None = None
         system.robot_limits = self.limits_in_force
 
     # -- configuration --------------------------------------------------------------------------
@@ -221,6 +222,7 @@ class ControllerNode(ComponentNode):
             self.cmd_publisher.assert_liveliness()
         self.last_published = twist
         self.published_any = True
+        self.last_publish_monotonic = time.monotonic()
 
     def robot_frame(self) -> str:
         tf_info = self.system.services.get("tf_info")
@@ -230,18 +232,21 @@ class ControllerNode(ComponentNode):
     def brake(self) -> None:
         """Brake within the deceleration limits and end with an exact zero command.
 
-        Runs in the calling thread at the system RT period (the RT loop no longer cycles).
+        Runs in the calling thread at the system RT period (the RT loop no longer cycles). Each
+        step of the ramp is one period's deceleration, so it is published at least one period
+        after the previous command (the RT cycle's last one included): a step published sooner,
+        e.g. right after a cycle that published, or to catch up after an overslept step, would
+        change the command faster than the deceleration limits.
         """
         output = self.velocity_output
         period = 1.0 / self.system.system_rt_freq
         if output is not None and self.published_any:
-            deadline = time.monotonic()
             for twist in output.brake_sequence(self.now_seconds(), period):
-                self.publish_twist(twist, self.now_seconds())
-                deadline += period
-                delay = deadline - time.monotonic()
+                last = self.last_publish_monotonic
+                delay = 0.0 if last is None else last + period - time.monotonic()
                 if delay > 0:
                     time.sleep(delay)
+                self.publish_twist(twist, self.now_seconds())
         if self.cmd_publisher is not None:
             self.publish_twist(Twist(), self.now_seconds())  # always end with an exact zero
         if output is not None:
