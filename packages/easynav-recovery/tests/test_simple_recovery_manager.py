@@ -20,7 +20,14 @@ from recovery_harness import (
 from easynav.core.plugins import PluginConfigurationError
 from easynav.core.robot import RobotGeometry
 from easynav.core.tf import get_tf_buffer
-from easynav.core.types import Header, Transform, TransformStamped, Twist
+from easynav.core.types import (
+    DiagnosticLevel,
+    DiagnosticStatus,
+    Header,
+    Transform,
+    TransformStamped,
+    Twist,
+)
 from easynav.recovery.simple import SimpleMitigation, SimpleRecoveryManager
 
 
@@ -161,6 +168,24 @@ def test_no_point_sensor_configured_is_not_a_lost_sensor():
     sim = simple()
     sim.run(10.0)
     assert not sim.actions.of("request_shutdown")
+
+
+def test_a_sensor_that_never_sent_data_counts_from_activation():
+    sim = simple()
+    sim.nav_state.set(
+        "diagnostics.sensors",
+        DiagnosticStatus(
+            DiagnosticLevel.WARN,
+            "sensors",
+            "no data: laser1",
+            "sensors_node",
+            {"no_data": "laser1", "stale": "", "sensors": "laser1"},
+        ),
+    )
+    sim.run(4.9)
+    assert not sim.actions.of("request_shutdown")
+    sim.run(0.3)
+    assert len(sim.actions.of("request_shutdown")) == 1
 
 
 def test_the_sensor_watch_restarts_on_activation():

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
+import yaml
 
 from easynav.core.testing.system_fixtures import system_params, wait_for
 
@@ -100,3 +103,22 @@ def test_an_unknown_mitigation_fails_configure_naming_it(params_file, runtime_fa
     assert not rt.start()
     assert "recovery_manager.cancel_mission.plugin" in rt.error
     assert "easynav_cancel_mission_recovery/CancelMissionRecovery" in rt.error
+
+
+@pytest.mark.parametrize(
+    ("example", "plugin"),
+    [
+        ("simple_recovery.params.yaml", "easynav_simple_recovery/SimpleRecoveryManager"),
+        (
+            "diagnostic_recovery.params.yaml",
+            "easynav_diagnostic_recovery/DiagnosticRecoveryManager",
+        ),
+    ],
+)
+def test_the_params_examples_configure(params_file, runtime_factory, example, plugin):
+    path = Path(__file__).resolve().parent.parent / "params" / example
+    recovery = yaml.safe_load(path.read_text())["recovery_node"]["ros__parameters"]
+    document = system_params(**{"recovery_node.recovery_manager": recovery["recovery_manager"]})
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    assert rt.system_node.loaded_plugins()["recovery_node"] == [("recovery_manager", plugin)]

@@ -26,6 +26,9 @@ SAFETY_STATUS = "safety_status"
 AMCL_COVARIANCE_TRACE = "localizer.amcl.covariance_trace"
 """float: var x + var y + var yaw of the AMCL particle cloud."""
 
+SENSORS_DIAGNOSTIC = "diagnostics.sensors"
+"""DiagnosticStatus of sensors_node; ``values["no_data"]`` lists the sensors without data yet."""
+
 RECONFIGURED_PARAMETERS = "reconfigured_parameters"
 """list[str]: ``node/parameter`` changed through ``request_reconfigure`` (system_node writes)."""
 

@@ -18,14 +18,20 @@ class TakeoverSlot:
     cycle and proposes it.
 
     Fail-safe: when the non-RT loop has not refreshed the command for ``max_age`` seconds (a
-    plugin hangs the non-RT cycle), :meth:`current` returns zero, so a stalled decision never
-    keeps the robot moving. Measured with the monotonic clock (``clock``), not ROS time.
+    plugin hangs the non-RT cycle; see :meth:`for_cycle`), :meth:`current` returns zero, so a
+    stalled decision never keeps the robot moving. Measured with the monotonic clock
+    (``clock``), not ROS time.
 
     Thread contract: ``engage``/``command``/``release`` from the non-RT thread, ``current`` from
     the RT thread; a lock held for a few assignments only.
     """
 
     DEFAULT_MAX_AGE = 0.5
+
+    @classmethod
+    def for_cycle(cls, system_freq: float) -> TakeoverSlot:
+        """A slot whose commands stay fresh for 0.5 s or three non-RT periods, the longer."""
+        return cls(max(cls.DEFAULT_MAX_AGE, 3.0 / system_freq))
 
     def __init__(
         self, max_age: float = DEFAULT_MAX_AGE, clock: Callable[[], float] = time.monotonic

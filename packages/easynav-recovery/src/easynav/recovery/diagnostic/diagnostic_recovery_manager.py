@@ -60,7 +60,7 @@ class DiagnosticRecoveryManager(RecoveryManagerBase):
 
     def on_initialize(self) -> None:
         self.schedule = ActivationAwareSchedule(self.freq, self._on_activation)
-        self._slot = TakeoverSlot()
+        self._slot = TakeoverSlot.for_cycle(self.context.system_freq)
         self._reports: list[tuple[int, str]] = []
         self._activated = True
         self._held: bool | None = None

@@ -13,7 +13,7 @@ from easynav.core.plugins import RecoveryManagerBase
 from easynav.core.robot import RobotGeometry
 from easynav.core.sensors import PointPerception
 from easynav.core.tf import get_tf_buffer
-from easynav.core.types import Odometry, Twist, TwistStamped
+from easynav.core.types import DiagnosticStatus, Odometry, Twist, TwistStamped
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.activation_aware_schedule import ActivationAwareSchedule
 from easynav.recovery.fused_point_cloud import FusedPointCloud
@@ -50,7 +50,8 @@ class SimpleRecoveryManager(RecoveryManagerBase):
 
     Non-RT (:meth:`update`, every non-RT cycle), most severe case first:
 
-    1. no new data from any point sensor for ``sensors_timeout`` → ``request_shutdown``;
+    1. no new data from any point sensor for ``sensors_timeout`` (counted from activation until
+       the first data arrives) → ``request_shutdown``;
     2. no mission → nothing to recover (a slow-down of the last mission is undone);
     3. position variance (x or y) above ``max_position_variance`` → hold the mission's progress
        and rotate at ``rotate_speed``; ``abort_mission`` after ``relocalize_timeout``;
@@ -91,7 +92,7 @@ class SimpleRecoveryManager(RecoveryManagerBase):
         self.slow_down_max_linear_vel = read_float(self, "slow_down_max_linear_vel", 0.1)
 
         self.schedule = ActivationAwareSchedule(self.freq, self._on_activation)
-        self._slot = TakeoverSlot()
+        self._slot = TakeoverSlot.for_cycle(self.context.system_freq)
         self._cloud = FusedPointCloud(
             self.context.namespace,
             z_min=self.min_obstacle_z,
@@ -258,7 +259,7 @@ class SimpleRecoveryManager(RecoveryManagerBase):
     def _sensors_lost(self, nav_state: NavState, now: float) -> bool:
         # New data changes the newest stamp of the valid perceptions (expired ones are invalid).
         perceptions = nav_state.get_by_type(PointPerception)
-        if not perceptions:
+        if not perceptions and not self._sensors_without_data(nav_state):
             return False  # no point sensor configured
         newest = max((p.stamp for p in perceptions.values() if p.valid), default=math.nan)
         if now < self._newest_sensor_arrival:
@@ -267,6 +268,13 @@ class SimpleRecoveryManager(RecoveryManagerBase):
             self._newest_sensor_stamp = newest
             self._newest_sensor_arrival = now
         return now - self._newest_sensor_arrival > self.sensors_timeout
+
+    @staticmethod
+    def _sensors_without_data(nav_state: NavState) -> bool:
+        # A sensor that never sent anything has no perception in NavState yet: sensors_node
+        # lists it in its diagnostic, so the watch counts from activation until the first data.
+        status = nav_state.get_or(keys.SENSORS_DIAGNOSTIC, None)
+        return isinstance(status, DiagnosticStatus) and bool(status.values.get("no_data"))
 
     def _position_variance(self, nav_state: NavState) -> float:
         if not nav_state.has(keys.ROBOT_POSE):
