@@ -5,8 +5,6 @@ from __future__ import annotations
 import time
 from typing import Any
 
-import pytest
-
 from easynav.core.robot import RobotLimits
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Twist
 
@@ -27,18 +25,6 @@ def level_is(rt, name: str, *levels: DiagnosticLevel) -> bool:
 def injector(rt, node: str):
     """The FaultInjector of the (only) plugin of ``node``."""
     return rt.system_node.subnodes[node].plugins[0].plugin.injector
-
-
-def xfail_without_supervisor(rt, parameter: str, what: str) -> None:
-    """``pytest.xfail`` when system_node does not declare ``parameter`` yet: the safety
-    supervisor that would produce ``what`` is not integrated (this is not a silent skip: the
-    test shows as XFAIL with this reason and turns into a real check once it is).
-    """
-    if not rt.system_node.has_parameter(parameter):
-        pytest.xfail(
-            f"{what} needs the safety supervisor in system_node (system_node.{parameter} is "
-            f"not declared: SafetySupervisor is not integrated yet)"
-        )
 
 
 def rt_cycles_per_second(ros, rt, seconds: float) -> float:
@@ -74,3 +60,22 @@ def assert_within_limits(samples: list[tuple[float, Twist]], limits: RobotLimits
 def stamped_overrides() -> dict[str, Any]:
     """Publish TwistStamped on cmd_vel_stamped, so rates can be checked on the stamps."""
     return {"controller_node.use_cmd_vel_stamped": True}
+
+
+def full_speed(twist: Twist | None) -> bool:
+    """The FaultyController's normal command of :mod:`fault_system` (the robot keeps going)."""
+    from fault_system import ANGULAR_VEL, LINEAR_VEL
+
+    return twist is not None and twist.vx == LINEAR_VEL and twist.wz == ANGULAR_VEL
+
+
+def navigate_to(ros, client, x: float, y: float, yaw: float = 0.0) -> None:
+    """Send a goal (or a goal update) with a GoalManagerClient and wait until it is accepted."""
+    from easynav.core.goals.goal_client_state import GoalClientState
+    from easynav.core.types import Header, Pose, PoseStamped
+
+    assert ros.spin_until(client.manager_available, timeout=10.0), "no goal manager"
+    client.send_goal(PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(x, y, yaw)))
+    assert ros.spin_until(
+        lambda: client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING, timeout=5.0
+    ), f"goal ({x}, {y}) not accepted: {client.get_state()}"
