@@ -84,6 +84,22 @@ class SimpleGridPlanner:
         return levels
 
     # -- planning -----------------------------------------------------------------------------
+    def goal_problem(self, world: SimpleMap, goal_xy: tuple[float, float]) -> str | None:
+        """Why the goal ``(x, y)`` cannot be planned to on ``world`` (outside it, occupied or
+        within the clearance of an obstacle), or None when its cell is free.
+        """
+        gx, gy = float(goal_xy[0]), float(goal_xy[1])
+        goal_text = f"goal ({gx:.2f}, {gy:.2f})"
+        coarse = self.coarse_map(world)
+        if not bool(coarse.contains(gx, gy)):
+            return f"{goal_text} is outside the map {_extent(coarse)}"
+        levels = self.danger_levels(coarse)
+        ix, iy = (int(v) for v in coarse.world_to_cell(gx, gy))
+        level = int(levels[iy, ix])
+        if level != FREE:
+            return f"{goal_text} is {_LEVEL_WORDS[level]}"
+        return None
+
     def plan(
         self,
         world: SimpleMap,
@@ -99,8 +115,9 @@ class SimpleGridPlanner:
         if world.width == 0 or world.height == 0:
             return PlanResult(reason=f"{goal_text}: the map is empty")
         coarse = self.coarse_map(world)
-        if not bool(coarse.contains(gx, gy)):
-            return PlanResult(reason=f"{goal_text} is outside the map {_extent(coarse)}")
+        problem = self.goal_problem(world, (gx, gy))
+        if problem is not None and not bool(coarse.contains(gx, gy)):
+            return PlanResult(reason=problem)
         if not bool(coarse.contains(sx, sy)):
             return PlanResult(
                 reason=f"{goal_text}: the robot at ({sx:.2f}, {sy:.2f}) is outside the map "
@@ -109,9 +126,8 @@ class SimpleGridPlanner:
         levels = self.danger_levels(coarse)
         start_cell = tuple(int(v) for v in coarse.world_to_cell(sx, sy))
         goal_cell = tuple(int(v) for v in coarse.world_to_cell(gx, gy))
-        goal_level = int(levels[goal_cell[1], goal_cell[0]])
-        if goal_level != FREE:
-            return PlanResult(reason=f"{goal_text} is {_LEVEL_WORDS[goal_level]}")
+        if problem is not None:
+            return PlanResult(reason=problem)
         cells = astar_8connected(levels, start_cell, goal_cell)
         if cells is None:
             return PlanResult(reason=f"{goal_text} is unreachable from ({sx:.2f}, {sy:.2f})")

@@ -16,6 +16,7 @@ from easynav.planners.simple_grid_planner import SimpleGridPlanner
 
 #: NavState keys.
 MAP_KEY = "map"
+STATIC_MAP_KEY = "map.base"
 PATH_KEY = "path"
 #: The planner's diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
 DIAGNOSTIC_NAME = "path"
@@ -143,10 +144,17 @@ class SimplePlanner(PlannerMethodBase):
         goal_text = f"goal ({gx:.2f}, {gy:.2f})"
         frame = goal.header.frame_id or goals.header.frame_id
         if frame and frame != map_frame:
-            self._fail(
-                nav_state, map_frame, f"{goal_text} is in frame '{frame}', not '{map_frame}'"
-            )
+            reason = f"{goal_text} is in frame '{frame}', not '{map_frame}'"
+            self.reject_goal(reason)
+            self._fail(nav_state, map_frame, reason)
             return
+        if nav_state.has(STATIC_MAP_KEY):
+            # Off the static map or inside (the clearance of) a wall: no path will ever come.
+            problem = self.planner.goal_problem(nav_state.get(STATIC_MAP_KEY, SimpleMap), (gx, gy))
+            if problem is not None:
+                self.reject_goal(problem)
+                self._fail(nav_state, map_frame, problem)
+                return
         if not nav_state.has("robot_pose"):
             self._fail(nav_state, map_frame, f"{goal_text}: no robot_pose yet")
             return

@@ -12,6 +12,7 @@ class PlannerNode(ComponentNode):
     """planner_node: ``planner_types`` (at most one), ``<alias>.*``.
 
     The planner runs at its ``freq``, and at once when ``goals`` changed since its last run.
+    A goal the planner rejects (``reject_goal``) ends the mission with the planner's reason.
     A path with a non-finite pose is discarded: ``path`` is left empty, so no controller follows
     it, and ``diagnostics.path`` is ERROR (hardware_id planner) until a finite path comes.
 
@@ -41,6 +42,10 @@ class PlannerNode(ComponentNode):
                     lp.plugin.schedule.restart(now)
                 self._planned_goals = goals
                 self.run_plugin(lp, "update")
+                rejection = lp.plugin.take_goal_rejection()
+                if rejection and goals is not None and len(goals) > 0:
+                    self.get_logger().warning(f"goal rejected by {lp.alias}: {rejection}")
+                    self.system.services["requests"].post_abort(rejection)
                 if lp.monitor is not None:
                     lp.monitor.record_run()
                 self._check_path(now)
