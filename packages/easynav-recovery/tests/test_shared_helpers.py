@@ -79,3 +79,14 @@ def test_nearest_obstacle_and_free_distance():
     assert math.isclose(free_distance_along_x(points, 1, 0.3), 0.5 - math.sqrt(0.08))
     assert math.isclose(free_distance_along_x(points, -1, 0.3), 1.0 - 0.3)
     assert math.isinf(free_distance_along_x(points[2:], 1, 0.3))  # 0.5 m aside: never touched
+
+
+def test_reports_log_at_every_level_on_an_rclpy_logger():
+    # rclpy refuses one call site logging at several severities: each level has its own call.
+    import rclpy.logging
+
+    from easynav.recovery.diagnostic.logging_levels import log_at
+
+    logger = rclpy.logging.get_logger("recovery_log_at_test")
+    for level in (10, 20, 30, 40, 50, 30, 40):
+        log_at(logger, level, f"level {level}")

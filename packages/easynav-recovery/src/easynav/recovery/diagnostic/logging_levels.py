@@ -12,15 +12,21 @@ FATAL = 50
 
 
 def log_at(logger: Any, level: int, message: str) -> None:
-    """Log ``message`` at ``level`` on an rclpy logger or a Python ``logging.Logger``."""
+    """Log ``message`` at ``level`` on an rclpy logger or a Python ``logging.Logger``.
+
+    One call per severity on its own line: rclpy raises ValueError when one call site logs at
+    different severities ("Logger severity cannot be changed between calls").
+    """
     if level >= FATAL:
-        method = getattr(logger, "fatal", None) or logger.critical
+        if hasattr(logger, "fatal"):
+            logger.fatal(message)
+        else:
+            logger.critical(message)
     elif level >= ERROR:
-        method = logger.error
+        logger.error(message)
     elif level >= WARN:
-        method = logger.warning
+        logger.warning(message)
     elif level >= INFO:
-        method = logger.info
+        logger.info(message)
     else:
-        method = logger.debug
-    method(message)
+        logger.debug(message)
