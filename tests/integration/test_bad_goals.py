@@ -44,7 +44,7 @@ def navigation(ros, params_file, runtime_factory):
     )
     node = ros.create_node("operator")
     client = GoalManagerClient(node)
-    assert ros.spin_until(client.manager_available, timeout=10.0)
+    assert ros.spin_until(client.manager_available, timeout=20.0)
     return rt, ros, client
 
 
@@ -53,7 +53,7 @@ def send_and_wait(ros, client, x, y, frame="map"):
         client.reset()
     client.send_goal(PoseStamped(Header(0.0, frame), Pose.from_xy_yaw(x, y)))
     terminal = (GoalClientState.NAVIGATION_FAILED, GoalClientState.NAVIGATION_REJECTED)
-    ros.spin_until(lambda: client.get_state() in terminal, timeout=10.0)
+    ros.spin_until(lambda: client.get_state() in terminal, timeout=20.0)
     return client.get_state(), client.get_result()
 
 
@@ -78,6 +78,6 @@ def test_impossible_goal_fails_with_the_reason_and_the_next_goal_is_taken(
     client.reset()
     client.send_goal(PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(6.5, 3.4)))
     assert ros.spin_until(
-        lambda: client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING, timeout=5.0
+        lambda: client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING, timeout=15.0
     )
-    assert wait_for(lambda: len(rt.nav_state.get_or("path", Path())) > 0, timeout=5.0)
+    assert wait_for(lambda: len(rt.nav_state.get_or("path", Path())) > 0, timeout=15.0)

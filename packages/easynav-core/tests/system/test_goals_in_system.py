@@ -17,7 +17,7 @@ def start_with_client(ros, params_file, runtime_factory):
     assert rt.start(), rt.error
     node = ros.create_node("test_operator")
     client = GoalManagerClient(node)
-    assert ros.spin_until(client.manager_available, timeout=10.0)
+    assert ros.spin_until(client.manager_available, timeout=20.0)
     return rt, client
 
 
@@ -26,7 +26,7 @@ def test_goal_is_accepted_and_survives_cleanup_and_configure(ros, params_file, r
     goal = PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(3.0, 1.0, 0.5))
     client.send_goal(goal)
     assert ros.spin_until(
-        lambda: client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING, timeout=5.0
+        lambda: client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING, timeout=15.0
     )
     node = rt.system_node
     # Reconfigure in the middle of the mission: active → inactive → unconfigured → active.
@@ -44,6 +44,6 @@ def test_goal_is_accepted_and_survives_cleanup_and_configure(ros, params_file, r
     assert client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING
     client.cancel()
     assert ros.spin_until(
-        lambda: client.get_state() == GoalClientState.NAVIGATION_CANCELLED, timeout=5.0
+        lambda: client.get_state() == GoalClientState.NAVIGATION_CANCELLED, timeout=15.0
     )
     assert wait_for(lambda: rt.nav_state.get("navigation_state") == "IDLE")

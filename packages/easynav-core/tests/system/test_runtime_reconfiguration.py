@@ -18,10 +18,10 @@ def running(ros, params_file, runtime_factory):
     assert rt.start(), rt.error
     node = ros.create_node("operator")
     client = GoalManagerClient(node)
-    assert ros.spin_until(client.manager_available, timeout=10.0)
+    assert ros.spin_until(client.manager_available, timeout=20.0)
     client.send_goal(PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(5.0, 0.0)))
     assert ros.spin_until(
-        lambda: client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING, timeout=5.0
+        lambda: client.get_state() == GoalClientState.ACCEPTED_AND_NAVIGATING, timeout=15.0
     )
     return rt
 
