@@ -112,7 +112,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_plugins(args: argparse.Namespace) -> int:
-    from easynav.core.plugins.discovery import check_imports, list_plugins
+    from easynav.core.plugins.discovery import check_imports, list_plugins, other_plugin_groups
     from easynav.core.plugins.plugin_kinds import ALL_KINDS
 
     infos = list_plugins()
@@ -121,6 +121,10 @@ def cmd_plugins(args: argparse.Namespace) -> int:
         print(f"{kind.name} ({kind.entry_point_group}):")
         if not rows:
             print("  (none installed)")
+        for info in rows:
+            print(f"  {info.name:<58} {info.distribution} {info.version}")
+    for group, rows in other_plugin_groups().items():
+        print(f"{group.removeprefix('easynav.').replace('_', ' ')} ({group}):")
         for info in rows:
             print(f"  {info.name:<58} {info.distribution} {info.version}")
     if args.do_import:

@@ -25,6 +25,19 @@ CATALOGUE: dict[str, str] = {
     # Recovery systems
     "easynav_simple_recovery/SimpleRecoveryManager": "easynav-recovery",
     "easynav_diagnostic_recovery/DiagnosticRecoveryManager": "easynav-recovery",
+    # Sub-plugins of the diagnostic recovery manager (their own entry-point groups)
+    "easynav_collision_safety_reflex/CollisionSafetyReflex": "easynav-recovery",
+    "easynav_no_path_evaluator/NoPathEvaluator": "easynav-recovery",
+    "easynav_controller_stuck_evaluator/ControllerStuckEvaluator": "easynav-recovery",
+    "easynav_obstacle_too_close_evaluator/ObstacleTooCloseEvaluator": "easynav-recovery",
+    "easynav_safety_channel_evaluator/SafetyChannelEvaluator": "easynav-recovery",
+    "easynav_costmap_localizer/AmclConvergenceEvaluator": "easynav-recovery",
+    "easynav_advance_recovery/AdvanceRecovery": "easynav-recovery",
+    "easynav_cancel_mission_recovery/CancelMissionRecovery": "easynav-recovery",
+    "easynav_costmap_localizer/AmclRelocalizeMitigation": "easynav-recovery",
+    "easynav_human_assistance_recovery/HumanAssistanceRecovery": "easynav-recovery",
+    "easynav_safe_retreat_recovery/SafeRetreatRecovery": "easynav-recovery",
+    "easynav_shutdown_recovery/ShutdownRecovery": "easynav-recovery",
     # Costmap stack and others (catalogued so the error names the package once they exist)
     "easynav_costmap_maps_manager/CostmapMapsManager": "easynav-maps",
     "easynav_costmap_localizer/AMCLLocalizer": "easynav-localizers",

@@ -54,6 +54,30 @@ def list_plugins(kind: PluginKind | None = None) -> list[PluginInfo]:
     return sorted(infos, key=lambda i: (i.kind.name, i.name))
 
 
+def other_plugin_groups() -> dict[str, list[PluginInfo]]:
+    """Plugins of kinds that packages define themselves (entry-point groups ``easynav.*`` that
+    are not core kinds, e.g. the diagnostic recovery's evaluators), by group; not imported.
+    """
+    core_groups = {k.entry_point_group for k in ALL_KINDS} | {"easynav.map_packages"}
+    groups: dict[str, list[PluginInfo]] = {}
+    for group in sorted(metadata.entry_points().groups):
+        if not group.startswith("easynav.") or group in core_groups:
+            continue
+        kind = PluginKind(group.removeprefix("easynav.").replace("_", " "), group, object, "")
+        for ep in _entry_points(group):
+            dist = ep.dist
+            groups.setdefault(group, []).append(
+                PluginInfo(
+                    name=ep.name,
+                    kind=kind,
+                    target=ep.value,
+                    distribution=dist.metadata["Name"] if dist else "?",
+                    version=dist.version if dist else "?",
+                )
+            )
+    return {g: sorted(infos, key=lambda i: i.name) for g, infos in groups.items()}
+
+
 def plugin_exists(kind: PluginKind, name: str) -> bool:
     """True when an installed distribution registers ``name`` in ``kind``'s group."""
     return any(ep.name == name for ep in _entry_points(kind.entry_point_group))

@@ -60,6 +60,12 @@ class MethodBase:
     def on_cleanup(self) -> None:
         """Release what ``on_initialize`` created (called on cleanup)."""
 
+    def on_activate(self) -> None:
+        """EasyNav becomes active (its cycles start). Lifecycle thread, loops not cycling."""
+
+    def on_deactivate(self) -> None:
+        """EasyNav becomes inactive (its cycles stop). Lifecycle thread, loops not cycling."""
+
     def _frequency(self, name: str, system_value: float, system_name: str) -> float:
         full = f"{self.plugin_name}.{name}"
         value = self.get_parameter(name, 10.0)

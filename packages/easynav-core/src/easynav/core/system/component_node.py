@@ -93,12 +93,21 @@ class ComponentNode(LifecycleNode):
                     monitor.restart()
             lp.plugin.rt_schedule.reset()
             lp.plugin.schedule.reset()
+            self._notify(lp, "on_activate")
         self.active = True
         return super().on_activate(state)
 
     def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
         self.active = False
+        for lp in self.plugins:
+            self._notify(lp, "on_deactivate")
         return super().on_deactivate(state)
+
+    def _notify(self, lp: LoadedPlugin, hook: str) -> None:
+        try:
+            getattr(lp.plugin, hook)()
+        except Exception as exc:  # a plugin's hook must not block the lifecycle
+            self.get_logger().error(f"{lp.alias}.{hook} raised {type(exc).__name__}: {exc}")
 
     def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
         self.active = False

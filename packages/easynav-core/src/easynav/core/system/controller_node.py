@@ -18,6 +18,7 @@ from rclpy.qos import (
 )
 
 from easynav.core.diagnostics import write_diagnostic
+from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
 from easynav.core.ros.converters import header_to_msg, twist_to_msg
@@ -33,9 +34,6 @@ DEPRECATED_LIMIT_PARAMETERS = {
     "max_angular_acc": "max_angular_acc",
 }
 
-# NavState keys of the velocity proposals (they last one RT cycle).
-PROPOSAL_TAKEOVER = "cmd_vel.proposal.takeover"
-PROPOSAL_OVERRIDE = "cmd_vel.proposal.override"
 
 
 class ControllerNode(ComponentNode):
@@ -188,9 +186,7 @@ class ControllerNode(ComponentNode):
         nav_state = self.nav_state
         now = self.now_seconds()
         controller_cmd = nav_state.get("cmd_vel") if nav_state.has("cmd_vel") else None
-        takeover = nav_state.get("cmd_vel.proposal.takeover") if nav_state.has(
-            PROPOSAL_TAKEOVER
-        ) else None
+        takeover = nav_state.get(PROPOSAL_TAKEOVER) if nav_state.has(PROPOSAL_TAKEOVER) else None
         override = nav_state.get(PROPOSAL_OVERRIDE) if nav_state.has(PROPOSAL_OVERRIDE) else None
         paused = bool(nav_state.get_or("navigation_paused", False))
         safety = nav_state.get("safety_status") if nav_state.has("safety_status") else None

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
 from easynav.core.plugins import RecoveryActions
 from easynav.core.plugins.plugin_kinds import RECOVERY_MANAGER
 from easynav.core.system.component_node import ComponentNode
-from easynav.core.system.controller_node import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
 from easynav.core.system.system_requests import ReconfigureRequest, SystemRequests
 from easynav.core.types import Twist
 
