@@ -11,7 +11,15 @@ import time
 import pytest
 from cmd_vel_recorder import CmdVelRecorder
 from fault_checks import full_speed, injector, level_is, rt_cycles_per_second
-from fault_system import LOCALIZER, MAPS_MANAGER, PLANNER, RT_FREQ, faulty_system, inject
+from fault_system import (
+    CONTROLLER,
+    LOCALIZER,
+    MAPS_MANAGER,
+    PLANNER,
+    RT_FREQ,
+    faulty_system,
+    inject,
+)
 
 from easynav.core.types import DiagnosticLevel
 
@@ -38,5 +46,34 @@ def test_throwing_plugin_is_contained_and_reported(ros, start_easynav, plugin):
     assert rt.requests.shutdown_reason is None
     received = recorder.between(since)
     assert len(received) >= 3 and all(full_speed(tw) for _, tw in received)
-    # It keeps failing, and stays reported while it does.
-    assert rt.nav_state.get(f"diagnostics.{alias}.error").level == DiagnosticLevel.ERROR
+
+
+SHARED_FAILING_FLAG = (
+    "core bug: ComponentNode.run_plugin (core/system/component_node.py) keeps one 'failing' "
+    "flag per plugin, shared by update_rt and update: the FaultyLocalizer's clean update() "
+    "writes diagnostics.<alias>.error OK ('running') between two update_rt() that raise, so "
+    "the ERROR flickers back to OK while the plugin keeps failing"
+)
+
+
+@pytest.mark.parametrize(
+    "plugin",
+    [
+        CONTROLLER,
+        pytest.param(LOCALIZER, marks=pytest.mark.xfail(strict=True, reason=SHARED_FAILING_FLAG)),
+        PLANNER,
+        MAPS_MANAGER,
+    ],
+    ids=lambda p: p[1],
+)
+def test_error_stays_reported_while_the_plugin_keeps_failing(ros, start_easynav, plugin):
+    node, alias, _ = plugin
+    rt = start_easynav(faulty_system(**inject(plugin, "throw", 3)))
+    assert ros.spin_until(lambda: level_is(rt, f"{alias}.error", DiagnosticLevel.ERROR), 5.0)
+    # Sample it every few milliseconds for a second: it never looks fine meanwhile.
+    seen = set()
+    end = time.monotonic() + 1.0
+    while time.monotonic() < end:
+        ros.spin_for(0.003)
+        seen.add(rt.nav_state.get(f"diagnostics.{alias}.error").level)
+    assert seen == {DiagnosticLevel.ERROR}
