@@ -34,7 +34,12 @@ def start(ros, start_easynav, fault: str, **params):
 
 @pytest.mark.parametrize(
     ("fault", "message"),
-    [("freeze", "older than"), ("stop_publishing", "older than"), ("nan", "not finite")],
+    [
+        ("freeze", "older than"),
+        ("stop_publishing", "older than"),
+        ("throw", "older than"),  # update_rt raises before writing: the last pose ages
+        ("nan", "not finite"),
+    ],
 )
 def test_old_or_nan_pose_is_reported_and_only_reported_outside_safety_mode(
     ros, start_easynav, fault, message

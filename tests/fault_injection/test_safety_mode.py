@@ -58,9 +58,12 @@ def start(ros, start_easynav, **overrides):
     return rt, recorder
 
 
-def test_hanging_rt_plugin_stops_easynav_with_exit_code_1(ros, start_easynav):
-    rt, recorder = start(ros, start_easynav, **inject(CONTROLLER, "hang", 100, hang_time=0.1))
-    assert ros.spin_until(lambda: injector(rt, CONTROLLER[0]).active, timeout=5.0)
+@pytest.mark.parametrize("plugin", [CONTROLLER, LOCALIZER], ids=lambda p: p[1])
+def test_hanging_rt_plugin_stops_easynav_with_exit_code_1(ros, start_easynav, plugin):
+    # fault_after: the robot is at full speed first (about 2 s at the plugin's rate).
+    fault_after = 100 if plugin is CONTROLLER else 40
+    rt, recorder = start(ros, start_easynav, **inject(plugin, "hang", fault_after, hang_time=0.1))
+    assert ros.spin_until(lambda: injector(rt, plugin[0]).active, timeout=5.0)
     assert ros.spin_until(rt.requests.shutdown_event.is_set, timeout=3.0)
     assert rt.nav_state.get("diagnostics.rt_cycle").level == DiagnosticLevel.ERROR
     result = rt.stop()  # what `easynav run` does when a stop is requested
