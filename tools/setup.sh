@@ -31,7 +31,12 @@ if [ ! -x "$VENV/bin/python" ]; then
   "$PY" -m venv "$VENV"
 fi
 mkdir -p "$STAMPS"
-PIP=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
+# pip_install ARGS: quiet pip, without the machine's notes about absent local index folders.
+pip_install() {
+  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check "$@" 2>&1 |
+    { grep -v "is ignored: it is neither a file nor a directory" || true; }
+  return "${PIPESTATUS[0]}"
+}
 
 hash_of() { cat "$@" 2>/dev/null | sha256sum | cut -c1-16; }
 
@@ -39,8 +44,8 @@ hash_of() { cat "$@" 2>/dev/null | sha256sum | cut -c1-16; }
 step=$(hash_of packages/easynav-interfaces/tools/build_requirements.txt requirements-dev.txt)
 if [ "$(cat "$STAMPS/tools" 2>/dev/null)" != "$step" ]; then
   log "installing build and test tools"
-  "${PIP[@]}" --upgrade pip "setuptools>=77" wheel hatchling editables
-  "${PIP[@]}" -r packages/easynav-interfaces/tools/build_requirements.txt -r requirements-dev.txt
+  pip_install --upgrade pip "setuptools>=77" wheel hatchling editables
+  pip_install -r packages/easynav-interfaces/tools/build_requirements.txt -r requirements-dev.txt
   echo "$step" > "$STAMPS/tools"
 fi
 
@@ -51,7 +56,7 @@ step=$(cd packages/easynav-interfaces && find . -path ./build -prune -o -type f 
 if [ "$(cat "$STAMPS/interfaces" 2>/dev/null)" != "$step" ] ||
    ! "$VENV/bin/python" -c 'import easynav_interfaces.msg, tf2_msgs.msg, vision_msgs.msg' 2>/dev/null; then
   log "building the ROS message packages (easynav_interfaces, tf2_msgs, vision_msgs)"
-  "${PIP[@]}" --no-build-isolation ./packages/easynav-interfaces
+  pip_install --no-build-isolation ./packages/easynav-interfaces
   echo "$step" > "$STAMPS/interfaces"
 fi
 
@@ -65,7 +70,7 @@ if [ "$(cat "$STAMPS/packages" 2>/dev/null)" != "$step" ]; then
     [ "$name" = easynav-interfaces ] && continue
     args+=(-e "$pkg")
   done
-  "${PIP[@]}" --no-build-isolation "${args[@]}"
+  pip_install --no-build-isolation "${args[@]}"
   echo "$step" > "$STAMPS/packages"
 fi
 log "environment ready: $VENV"
