@@ -48,19 +48,13 @@ def test_throwing_plugin_is_contained_and_reported(ros, start_easynav, plugin):
     assert len(received) >= 3 and all(full_speed(tw) for _, tw in received)
 
 
-SHARED_FAILING_FLAG = (
-    "core bug: ComponentNode.run_plugin (core/system/component_node.py) keeps one 'failing' "
-    "flag per plugin, shared by update_rt and update: the FaultyLocalizer's clean update() "
-    "writes diagnostics.<alias>.error OK ('running') between two update_rt() that raise, so "
-    "the ERROR flickers back to OK while the plugin keeps failing"
-)
 
 
 @pytest.mark.parametrize(
     "plugin",
     [
         CONTROLLER,
-        pytest.param(LOCALIZER, marks=pytest.mark.xfail(strict=True, reason=SHARED_FAILING_FLAG)),
+        LOCALIZER,
         PLANNER,
         MAPS_MANAGER,
     ],

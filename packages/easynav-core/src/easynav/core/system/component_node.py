@@ -34,7 +34,7 @@ class LoadedPlugin:
         self.diag_name = diag_name
         self.rt_monitor: RateMonitor | None = None
         self.monitor: RateMonitor | None = None
-        self.failing = False
+        self.failing: set[str] = set()  # methods whose last call raised
 
 
 class ComponentNode(LifecycleNode):
@@ -225,7 +225,8 @@ class ComponentNode(LifecycleNode):
         """Call ``lp.plugin.<method>(nav_state)``; contain and report exceptions.
 
         Returns ``(ok, result)``. An exception is logged at most once per second, reported as an
-        ERROR ``diagnostics.<alias>.error`` while it repeats, and OK again after a clean run.
+        ERROR ``diagnostics.<alias>.error`` while it repeats, and OK again once every method of
+        the plugin that raised has run cleanly.
         """
         try:
             result = getattr(lp.plugin, method)(self.nav_state)
@@ -238,7 +239,6 @@ class ComponentNode(LifecycleNode):
                     f"{lp.name} ({lp.alias}).{method} raised {type(exc).__name__}: {exc}"
                 )
             if not lp.failing:
-                lp.failing = True
                 write_diagnostic(
                     self.nav_state,
                     f"{lp.diag_name}.error",
@@ -249,14 +249,18 @@ class ComponentNode(LifecycleNode):
                         values={"plugin": lp.name},
                     ),
                 )
+            lp.failing.add(method)
             return False, None
-        if lp.failing:
-            lp.failing = False
-            write_diagnostic(
-                self.nav_state,
-                f"{lp.diag_name}.error",
-                DiagnosticStatus(
-                    DiagnosticLevel.OK, message="running", hardware_id=self.get_name()
-                ),
-            )
+        if method in lp.failing:
+            lp.failing.discard(method)
+            # OK only when no method of the plugin is failing any more (an RT update that keeps
+            # raising is not cured by a clean non-RT update).
+            if not lp.failing:
+                write_diagnostic(
+                    self.nav_state,
+                    f"{lp.diag_name}.error",
+                    DiagnosticStatus(
+                        DiagnosticLevel.OK, message="running", hardware_id=self.get_name()
+                    ),
+                )
         return True, result

@@ -67,6 +67,15 @@ def wait_for(predicate: Callable[[], Any], timeout: float = 5.0, period: float =
     return value
 
 
+class _ParamsDumper(yaml.SafeDumper):
+    """Quotes every string: ROS reads a plain ``nan``, ``on`` or ``1e3`` as a number or bool."""
+
+
+_ParamsDumper.add_representer(
+    str, lambda dumper, value: dumper.represent_scalar("tag:yaml.org,2002:str", value, style='"')
+)
+
+
 @pytest.fixture
 def params_file(tmp_path: Path) -> Callable[[dict[str, Any]], str]:
     """``params_file(document) -> path`` of a temporary YAML file."""
@@ -74,7 +83,7 @@ def params_file(tmp_path: Path) -> Callable[[dict[str, Any]], str]:
 
     def write(document: dict[str, Any]) -> str:
         path = tmp_path / f"params_{next(counter)}.yaml"
-        path.write_text(yaml.safe_dump(document, sort_keys=False))
+        path.write_text(yaml.dump(document, Dumper=_ParamsDumper, sort_keys=False))
         return str(path)
 
     return write
