@@ -1,0 +1,166 @@
+"""No stale velocity commands, and faulty controllers contained (seed-safety.txt "Stale and
+invalid commands"), end to end: the test is the robot's driver on ``cmd_vel_stamped`` and
+scripts the FaultyController of a running EasyNav (its fault can be switched off again from
+the test thread: a plain attribute the RT thread reads every update).
+"""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from safety_e2e_harness import (
+    RobotDriver,
+    assert_ramps_up_from_zero,
+    assert_within_limits,
+    full_speed,
+)
+from safety_e2e_params import (
+    ANGULAR_VEL,
+    BRAKING_TIME,
+    CMD_TIMEOUT,
+    CONTROLLER,
+    CONTROLLER_RT_FREQ,
+    LIMITS,
+    LINEAR_VEL,
+    fault,
+    system,
+)
+
+from easynav.core.types import DiagnosticLevel, Twist
+
+pytestmark = pytest.mark.ros
+
+CONTROLLER_PERIOD = 1.0 / CONTROLLER_RT_FREQ
+
+
+def moving(twist) -> bool:
+    return full_speed(twist, LINEAR_VEL, ANGULAR_VEL)
+
+
+def start(ros, start_easynav, **overrides):
+    driver = RobotDriver(ros)
+    rt = start_easynav(system(**overrides))
+    assert ros.spin_until(driver.connected, timeout=5.0)
+    return rt, driver
+
+
+def injector(rt):
+    return rt.system_node.controller_node.plugins[0].plugin.injector
+
+
+def wait_for_fault(ros, rt) -> float:
+    """Spin until the controller injects its fault; the node-clock time it started."""
+    faulty = injector(rt)
+    assert ros.spin_until(lambda: faulty.active, timeout=5.0), "the fault never started"
+    return faulty.started_at
+
+
+def diagnostic(rt, name):
+    return rt.nav_state.get_or(f"diagnostics.{name}", None)
+
+
+def stopped_after(driver, t: float) -> bool:
+    """The last command received is an exact zero computed after ``t`` (node clock)."""
+    return bool(driver.samples) and driver.samples[-1].stamp > t and driver.last().is_zero()
+
+
+@pytest.mark.parametrize("fault_name", ["stop_proposing", "freeze", "nan"])
+def test_stale_or_invalid_commands_brake_to_zero_after_cmd_timeout_until_commands_flow_again(
+    ros, start_easynav, fault_name
+):
+    rt, driver = start(ros, start_easynav, **fault(fault_name, fault_after=25))
+    fault_time = wait_for_fault(ros, rt)
+    assert ros.spin_until(lambda: stopped_after(driver, fault_time), timeout=3.0), (
+        f"with '{fault_name}' the robot kept receiving {driver.last()}"
+    )
+    before = [s for s in driver.samples if s.stamp < fault_time]
+    assert before and moving(before[-1].twist), "the robot was not moving when the fault began"
+    # The robot keeps the last valid command until cmd_timeout after it (which came at most one
+    # controller period before the fault), then brakes within the deceleration limits.
+    braking = [s for s in driver.stamped_after(fault_time) if not moving(s.twist)]
+    assert braking[0].stamp - fault_time >= CMD_TIMEOUT - CONTROLLER_PERIOD - 1e-3
+    assert braking[-1].stamp - braking[0].stamp >= BRAKING_TIME - 2 * CONTROLLER_PERIOD
+    assert_within_limits(driver.samples, LIMITS)  # also: no NaN ever reaches the robot
+    status = diagnostic(rt, "cmd_vel")
+    assert status.level == DiagnosticLevel.ERROR and status.hardware_id == "controller_node"
+    assert status.values["timeout"] == "true"
+    assert f"cmd_timeout = {CMD_TIMEOUT:g} s" in status.message
+    if fault_name == "nan":
+        assert status.values["discarded"] == "controller"
+
+    # The controller works again: commands flow, the diagnostic is OK, the robot resumes from 0.
+    recovered_at = time.time()
+    injector(rt).fault = "none"
+    assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
+    assert_ramps_up_from_zero(driver.stamped_after(recovered_at), LIMITS)
+    status = diagnostic(rt, "cmd_vel")
+    assert status.level == DiagnosticLevel.OK
+    assert status.message == "velocity commands flowing again"
+
+
+def test_no_diagnostic_while_commands_flow(ros, start_easynav):
+    rt, driver = start(ros, start_easynav)
+    assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
+    ros.spin_for(CMD_TIMEOUT * 2)
+    # Written only after the first problem: nothing to report.
+    assert diagnostic(rt, "cmd_vel") is None
+    assert moving(driver.last())
+
+
+def test_a_controller_stopping_at_rest_is_not_a_stale_command(ros, start_easynav):
+    rt, driver = start(
+        ros,
+        start_easynav,
+        **{"controller_node.ctrl.linear_vel": 0.0, "controller_node.ctrl.angular_vel": 0.0},
+    )
+    injector(rt).fault = "stop_proposing"  # keeps the zero command: nothing stale to brake
+    ros.spin_for(CMD_TIMEOUT * 2)
+    assert diagnostic(rt, "cmd_vel") is None
+    assert all(s.twist.is_zero() for s in driver.samples)
+
+
+def test_throwing_controller_is_contained_the_robot_brakes_and_resumes(ros, start_easynav):
+    rt, driver = start(ros, start_easynav, **fault("throw", fault_after=25))
+    fault_time = wait_for_fault(ros, rt)
+    assert ros.spin_until(lambda: stopped_after(driver, fault_time), timeout=3.0)
+    # A failing controller stops the robot: braked within the deceleration limits, not dead.
+    braking = [s for s in driver.stamped_after(fault_time) if not moving(s.twist)]
+    assert braking[-1].stamp - braking[0].stamp >= BRAKING_TIME - 2 * CONTROLLER_PERIOD
+    assert_within_limits(driver.samples, LIMITS)
+    status = diagnostic(rt, "ctrl.error")
+    assert status.level == DiagnosticLevel.ERROR and status.hardware_id == "controller_node"
+    assert "InjectedFaultError" in status.message and status.values["plugin"] == CONTROLLER
+    assert rt.system_node.lifecycle_state() == "active"
+    assert rt.requests.shutdown_reason is None
+
+    recovered_at = time.time()
+    injector(rt).fault = "none"
+    assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
+    assert_ramps_up_from_zero(driver.stamped_after(recovered_at), LIMITS)
+    assert diagnostic(rt, "ctrl.error").level == DiagnosticLevel.OK
+
+
+def test_non_finite_recovery_proposals_are_discarded_for_the_next_valid_source(ros, start_easynav):
+    rt, driver = start(ros, start_easynav)
+    assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
+    manager = rt.system_node.recovery_node.plugins[0].plugin
+    actions = rt.system_node.recovery_node.actions
+
+    def nan_override(nav_state) -> bool:
+        actions.override_velocity(Twist(vx=float("nan")))
+        actions.command_velocity(Twist(vx=float("inf")))
+        return True
+
+    manager.update_rt = nan_override
+    since = time.monotonic()
+    ros.spin_for(0.3)
+    # The controller is the next valid source: the robot keeps its command.
+    assert all(moving(s.twist) for s in driver.received_after(since))
+    status = diagnostic(rt, "cmd_vel")
+    assert status.level == DiagnosticLevel.ERROR
+    assert set(status.values["discarded"].split(", ")) == {"override", "takeover"}
+    del manager.update_rt
+    assert ros.spin_until(
+        lambda: diagnostic(rt, "cmd_vel").level == DiagnosticLevel.OK, timeout=2.0
+    )
