@@ -164,3 +164,38 @@ def test_non_finite_recovery_proposals_are_discarded_for_the_next_valid_source(r
     assert ros.spin_until(
         lambda: diagnostic(rt, "cmd_vel").level == DiagnosticLevel.OK, timeout=2.0
     )
+
+
+def test_after_the_clock_jumps_back_cmd_timeout_counts_from_the_jump(ros, start_easynav):
+    """Simulated time restarts (``/clock`` jumps back 10 s) just as the controller stops
+    proposing: the robot must not keep its command forever, it brakes cmd_timeout after the jump.
+    """
+    from rosgraph_msgs.msg import Clock
+
+    simulator = ros.create_node("simulator")
+    clock_publisher = simulator.create_publisher(Clock, "/clock", 10)
+    origin = {"sim": 1000.0, "mono": time.monotonic()}
+
+    def tick() -> None:
+        now = origin["sim"] + time.monotonic() - origin["mono"]
+        msg = Clock()
+        msg.clock.sec, msg.clock.nanosec = int(now), int((now % 1.0) * 1e9)
+        clock_publisher.publish(msg)
+
+    simulator.create_timer(0.002, tick)
+    nodes = ["system_node", "controller_node", "localizer_node", "planner_node",
+             "maps_manager_node", "sensors_node", "recovery_node"]  # fmt: skip
+    rt, driver = start(ros, start_easynav, **{f"{n}.use_sim_time": True for n in nodes})
+    assert ros.spin_until(lambda: driver.last_is(moving), timeout=5.0)
+    assert driver.samples[-1].stamp >= 1000.0  # commands are stamped in simulated time
+
+    jump_to = 990.0
+    injector(rt).fault = "stop_proposing"
+    origin.update(sim=jump_to, mono=time.monotonic())
+    tick()
+    assert ros.spin_until(lambda: stopped_after(driver, jump_to), timeout=3.0), driver.last()
+    after = [s for s in driver.samples if s.stamp < 1000.0]
+    braking = [s for s in after if not moving(s.twist)]
+    assert braking[0].stamp - jump_to >= CMD_TIMEOUT - 1e-3
+    assert_within_limits(after, LIMITS)
+    assert diagnostic(rt, "cmd_vel").values["timeout"] == "true"
