@@ -10,9 +10,12 @@ from pathlib import Path
 import yaml
 
 from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.world import World
 
 WORLDS_DIR = Path(str(resources.files("easynav.playground") / "worlds"))
+#: Keys of a moving-obstacle entry that make it a :class:`ScriptedObstacle`.
+_SCRIPT_KEYS = {"start_time", "start_distance", "repeat", "pause"}
 
 
 @dataclass
@@ -26,6 +29,12 @@ class WorldDescription:
         waypoints: home.waypoints.yaml # default waypoint list of the demo (optional)
         moving_obstacles:              # optional
           - {name: person, radius: 0.2, speed: 0.3, waypoints: [[5.0, 0.9], [6.2, 0.9]]}
+          # scripted (any of start_time, start_distance, repeat, pause): waits at its first
+          # waypoint until start_time (s) and, if given, until the robot is within
+          # start_distance (m) of it, then walks the waypoints once (repeat: false, the
+          # default; standing pause s at each intermediate waypoint) or back and forth
+          - {name: crosser, speed: 0.5, start_distance: 1.3, pause: 4.0,
+             waypoints: [[7.1, 4.3], [7.1, 3.4], [7.1, 5.6]]}
 
     Thread contract: plain data; build it before starting threads.
     """
@@ -38,7 +47,9 @@ class WorldDescription:
     source: str = ""
 
     def make_obstacles(self) -> list[MovingObstacle]:
-        """Fresh :class:`MovingObstacle` objects (at their first waypoint).
+        """Fresh :class:`MovingObstacle` objects (at their first waypoint); a
+        :class:`ScriptedObstacle` for an entry with ``start_time``, ``start_distance``,
+        ``repeat`` or ``pause``.
 
         Raises:
             ValueError: a malformed obstacle entry (names the entry).
@@ -47,15 +58,32 @@ class WorldDescription:
         for i, spec in enumerate(self.obstacles):
             if not isinstance(spec, dict) or "waypoints" not in spec:
                 raise ValueError(f"{self.source}: moving_obstacles[{i}] needs 'waypoints'")
-            unknown = set(spec) - {"name", "radius", "speed", "waypoints"}
+            unknown = set(spec) - {"name", "radius", "speed", "waypoints", *_SCRIPT_KEYS}
             if unknown:
                 raise ValueError(f"{self.source}: moving_obstacles[{i}] has unknown keys {unknown}")
+            common = {
+                "radius": float(spec.get("radius", 0.25)),
+                "speed": float(spec.get("speed", 0.4)),
+                "name": str(spec.get("name", f"obstacle {i}")),
+            }
+            if not _SCRIPT_KEYS & set(spec):
+                result.append(MovingObstacle(spec["waypoints"], **common))
+                continue
+            repeat = spec.get("repeat", False)
+            if not isinstance(repeat, bool):
+                raise ValueError(
+                    f"{self.source}: moving_obstacles[{i}].repeat must be true or false, "
+                    f"got {repeat!r}"
+                )
+            distance = spec.get("start_distance")
             result.append(
-                MovingObstacle(
+                ScriptedObstacle(
                     spec["waypoints"],
-                    radius=float(spec.get("radius", 0.25)),
-                    speed=float(spec.get("speed", 0.4)),
-                    name=str(spec.get("name", f"obstacle {i}")),
+                    **common,
+                    start_time=float(spec.get("start_time", 0.0)),
+                    start_distance=None if distance is None else float(distance),
+                    repeat=repeat,
+                    pause=float(spec.get("pause", 0.0)),
                 )
             )
         return result

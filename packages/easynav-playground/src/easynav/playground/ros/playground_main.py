@@ -43,6 +43,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-obstacles", action="store_true", help="leave the world's moving obstacles out"
     )
     parser.add_argument(
+        "--hold",
+        action="store_true",
+        help="start with the robot held in place (wheels blocked; release it with a latched "
+        "std_msgs/Bool false on playground/hold)",
+    )
+    parser.add_argument(
         "--record", help="write the ground truth of the run to this JSON file on exit"
     )
     parser.add_argument(
@@ -84,6 +90,8 @@ def main(argv: list[str] | None = None) -> int:
             values[name] = getattr(options, option)
     if options.no_obstacles:
         values["moving_obstacles"] = False
+    if options.hold:
+        values["hold"] = True
 
     stop = threading.Event()
     rclpy.init(

@@ -12,7 +12,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
-from std_msgs.msg import String
+from std_msgs.msg import Bool, String
 
 from easynav.core.tf import StaticTFBroadcaster, TFBroadcaster
 from easynav.playground.fixed_rate_loop import FixedRateLoop
@@ -38,6 +38,7 @@ DEFAULT_PARAMETERS: dict[str, object] = {
     "cmd_timeout": 0.0,
     "odom_rate": 50.0,
     "moving_obstacles": True,
+    "hold": False,
     "record": "",
     "map_frame": "map",
     "odom_frame": "odom",
@@ -81,8 +82,10 @@ class PlaygroundNode(Node):
     base_footprint`` transform on ``tf`` (``odom_rate``), ``ground_truth`` (true pose in the map
     frame, same rate), the static ``base_footprint -> base_link -> base_laser`` transforms on
     ``tf_static``, ``collisions`` (latched JSON: count and the last collision) and the world on
-    ``playground/world`` (latched OccupancyGrid). Subscribes ``cmd_vel`` (Twist) and
-    ``cmd_vel_stamped`` (TwistStamped). It publishes /clock; it does not use it.
+    ``playground/world`` (latched OccupancyGrid). Subscribes ``cmd_vel`` (Twist),
+    ``cmd_vel_stamped`` (TwistStamped) and ``playground/hold`` (std_msgs/Bool, transient local:
+    hold the robot in place, wheels blocked; the ``hold`` parameter is the initial state). It
+    publishes /clock; it does not use it.
 
     Thread contract: construct, :meth:`start` and :meth:`stop` from the main thread. Command
     callbacks run in the executor thread and only hand the command to the simulation (under
@@ -156,6 +159,7 @@ class PlaygroundNode(Node):
                 "laser_frame",
             )
         }
+        self.sim.set_held(bool(p("hold")))
         self._base_link_height = float(p("base_link_height"))
         self._laser_z = float(p("laser.z"))
 
@@ -173,6 +177,8 @@ class PlaygroundNode(Node):
         self.create_subscription(
             TwistStamped, "cmd_vel_stamped", self._on_cmd_vel_stamped, _RELIABLE
         )
+        # Transient local, so that a latched hold published before this node started applies.
+        self.create_subscription(Bool, "playground/hold", self._on_hold, _LATCHED)
         self._warned_lateral = False
         self._rejected_commands = 0
 
@@ -244,6 +250,10 @@ class PlaygroundNode(Node):
         data["commands_received"] = self.sim.commands_received
         data["commands_rejected"] = self._rejected_commands
         data["start_pose"] = list(self.start_pose)
+        data["obstacles"] = [
+            {"name": o.name, "started_at": getattr(o, "started_at", 0.0)}
+            for o in self.sim.obstacles
+        ]
         data["world"] = self.description.world.name
         tmp = Path(path).with_name(Path(path).name + ".tmp")
         tmp.write_text(json.dumps(data))
@@ -314,6 +324,14 @@ class PlaygroundNode(Node):
         )
 
     # ------------------------------------------------------------------ executor thread
+    def _on_hold(self, msg: Bool) -> None:
+        if bool(msg.data) != self.sim.held:
+            self.sim.set_held(msg.data)
+            self.get_logger().warning(
+                f"robot {'held in place (wheels blocked)' if msg.data else 'released'} at "
+                f"t={self.sim.time:.2f} s"
+            )
+
     def _on_cmd_vel(self, msg: Twist) -> None:
         self._command(msg)
 

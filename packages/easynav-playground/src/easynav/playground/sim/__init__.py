@@ -8,6 +8,7 @@ from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.sim.laser_scanner import LaserScanner
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.ray_casting import cast_rays_discs, cast_rays_grid
+from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.simulation import Simulation
 from easynav.playground.sim.wheel_odometry import WheelOdometry
 from easynav.playground.sim.world import World
@@ -20,6 +21,7 @@ __all__ = [
     "GroundTruthRecorder",
     "LaserScanner",
     "MovingObstacle",
+    "ScriptedObstacle",
     "Simulation",
     "WheelOdometry",
     "World",

@@ -56,6 +56,12 @@ class MovingObstacle:
         """Length of one way along the waypoints (m)."""
         return float(self._cumulative[-1])
 
+    def observe(self, time: float, robot_x: float, robot_y: float) -> None:
+        """Called by the simulation before each step with the simulated time and the robot's
+        true position. A plain obstacle ignores it; a :class:`ScriptedObstacle` starts walking
+        from it.
+        """
+
     def position_after(self, dt: float) -> tuple[float, float]:
         """Where the obstacle would be after ``dt`` more seconds of walking."""
         return self._position_at(self._travelled + self.speed * dt)

@@ -27,15 +27,21 @@ class Simulation:
 
     Each :meth:`step`: take the latest velocity command, ramp and integrate the robot, stop it
     instead of entering a wall or an obstacle (a collision is recorded), move the obstacles
-    (they wait rather than walk into the robot), feed the odometry the true motion, and call
+    (they wait rather than walk into the robot; each first :meth:`~MovingObstacle.observe` s the
+    time and the robot), feed the odometry the true motion, and call
     the sensor callbacks that are due: ``on_scan(stamp, ranges)`` at the scanner rate,
     ``on_odometry(stamp)`` at ``odom_rate``; ``on_collision(collision)`` when one starts.
     Stamps are simulated time at the end of the step.
 
+    A robot :attr:`held` in place (:meth:`set_held`, wheels blocked: a test scenario) does not
+    move whatever it is commanded; its velocities are zero and the odometry sees no motion.
+    Commands are still taken, so it drives on when released.
+
     The laser is mounted at ``laser_offset`` ``(x, y, yaw)`` in the robot frame.
 
     Thread contract: :meth:`step` and the callbacks run in one thread (the simulation loop);
-    :meth:`set_command` may be called from any thread (it only stores the command under a lock).
+    :meth:`set_command` and :meth:`set_held` may be called from any thread (they only store
+    under a lock).
 
     Raises:
         ValueError: a step or rate not finite and > 0, or a start pose in collision.
@@ -74,6 +80,7 @@ class Simulation:
         self.on_collision: list[CollisionCallback] = []
         self._command_lock = threading.Lock()
         self._pending_command: tuple[float, float] | None = None
+        self._held = False
         self.commands_received = 0
         self._next_scan = scanner.period
         self._next_odom = self.odom_period
@@ -97,6 +104,17 @@ class Simulation:
             self._pending_command = (float(v), float(w))
             self.commands_received += 1
 
+    def set_held(self, held: bool) -> None:
+        """Hold the robot in place (True) or release it (False) from the next step on."""
+        with self._command_lock:
+            self._held = bool(held)
+
+    @property
+    def held(self) -> bool:
+        """Whether the robot is held in place."""
+        with self._command_lock:
+            return self._held
+
     # ------------------------------------------------------------------ state
     def laser_pose(self) -> tuple[float, float, float]:
         """World pose of the laser ``(x, y, yaw)``."""
@@ -116,13 +134,18 @@ class Simulation:
         now = self.time
         with self._command_lock:
             command, self._pending_command = self._pending_command, None
+            held = self._held
         robot = self.robot
         if command is not None:
             robot.set_command(command[0], command[1], now)
 
         x, y, yaw, v, w = robot.next_state(dt, now)
-        what = self.checker.colliding_with(x, y, self.obstacles)
-        if what is None:
+        what = None if held else self.checker.colliding_with(x, y, self.obstacles)
+        if held:
+            # Wheels blocked: commanded, not moving, and the encoders count nothing.
+            robot.stop()
+            self.odometry.update(0.0, 0.0, dt)
+        elif what is None:
             dyaw = (yaw - robot.yaw + math.pi) % (2.0 * math.pi) - math.pi
             robot.apply_state(x, y, yaw, v, w)
             self.odometry.update(v * dt, dyaw, dt)
@@ -131,6 +154,7 @@ class Simulation:
             robot.stop()
             self.odometry.update(0.0, 0.0, dt)
         for obstacle in self.obstacles:
+            obstacle.observe(now, robot.x, robot.y)
             ox, oy = obstacle.position_after(dt)
             gap = (
                 math.hypot(ox - robot.x, oy - robot.y) - obstacle.radius - self.checker.robot_radius
