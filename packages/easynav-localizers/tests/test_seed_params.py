@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 import pytest
 import yaml
 
@@ -38,7 +36,6 @@ localizer_node:
 
 
 def test_seed_section_configures_the_plugin_through_ros_parameters(tmp_path):
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "OFF"
     rclpy = pytest.importorskip("rclpy")
     from easynav.core.system.node_parameters import NodeParameters
 

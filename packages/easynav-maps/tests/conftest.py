@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import time
 
 import pytest
@@ -38,7 +37,6 @@ class RosHarness:
 @pytest.fixture
 def ros(request):
     """A node named after the test module, isolated from other processes' DDS traffic."""
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "OFF"
     rclpy = pytest.importorskip("rclpy")
     harness = RosHarness(rclpy, "maps_manager_node")
     yield harness
