@@ -213,6 +213,29 @@ class ComponentNode(LifecycleNode):
         return [(lp.alias, lp.name) for lp in self.plugins]
 
     # -- cycle helpers ------------------------------------------------------------------------
+    def run_scheduled(self, rt: bool, force: bool = False) -> list[tuple[LoadedPlugin, bool]]:
+        """Run every plugin's ``update_rt`` (``rt``) or ``update`` when it is due or ``force``d
+        (a forced run restarts its schedule), and feed its rate monitor.
+
+        Returns ``(plugin, ok)`` for each plugin that ran. Thread: the loop of ``rt``.
+        """
+        now = self.now_seconds()
+        method = "update_rt" if rt else "update"
+        ran = []
+        for lp in self.plugins:
+            plugin = lp.plugin
+            monitor = lp.rt_monitor if rt else lp.monitor
+            due = plugin.is_time_to_run_rt(now) if rt else plugin.is_time_to_run(now)
+            if due or force:
+                if force:
+                    (plugin.rt_schedule if rt else plugin.schedule).restart(now)
+                ok, _ = self.run_plugin(lp, method)
+                ran.append((lp, ok))
+                if monitor is not None:
+                    monitor.record_run()
+            self.check_rate(lp, monitor, now)
+        return ran
+
     def check_rate(self, lp: LoadedPlugin, monitor: RateMonitor | None, now: float) -> None:
         """Feed a rate monitor and write its diagnostic when it changes."""
         if monitor is None:

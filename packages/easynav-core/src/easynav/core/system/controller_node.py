@@ -165,18 +165,11 @@ class ControllerNode(ComponentNode):
         """Run the controller when due or triggered. RT thread."""
         if not self.active:
             return
-        now = self.now_seconds()
-        for lp in self.plugins:
-            if lp.plugin.is_time_to_run_rt(now) or trigger:
-                if trigger:
-                    lp.plugin.rt_schedule.restart(now)
-                ok, _ = self.run_plugin(lp, "update_rt")
-                if not ok:
-                    # A failing controller stops the robot: a new zero command (braked smoothly).
-                    self.nav_state.set("cmd_vel", TwistStamped(Header(now, ""), Twist()))
-                if lp.rt_monitor is not None:
-                    lp.rt_monitor.record_run()
-            self.check_rate(lp, lp.rt_monitor, now)
+        for _lp, ok in self.run_scheduled(rt=True, force=trigger):
+            if not ok:
+                # A failing controller stops the robot: a new zero command (braked smoothly).
+                now = self.now_seconds()
+                self.nav_state.set("cmd_vel", TwistStamped(Header(now, ""), Twist()))
 
     def publish_cycle(self) -> None:
         """Mux → smoother → guard → publish. RT thread, after the recovery system's RT cycle."""

@@ -35,27 +35,9 @@ class LocalizerNode(ComponentNode):
         """Predict when due or triggered; True when the localizer ran. RT thread."""
         if not self.active:
             return False
-        ran = False
-        now = self.now_seconds()
-        for lp in self.plugins:
-            if lp.plugin.is_time_to_run_rt(now) or trigger:
-                if trigger:
-                    lp.plugin.rt_schedule.restart(now)
-                self.run_plugin(lp, "update_rt")
-                ran = True
-                if lp.rt_monitor is not None:
-                    lp.rt_monitor.record_run()
-            self.check_rate(lp, lp.rt_monitor, now)
-        return ran
+        return bool(self.run_scheduled(rt=True, force=trigger))
 
     def cycle(self) -> None:
         """Correct when due. Non-RT thread."""
-        if not self.active:
-            return
-        now = self.now_seconds()
-        for lp in self.plugins:
-            if lp.plugin.is_time_to_run(now):
-                self.run_plugin(lp, "update")
-                if lp.monitor is not None:
-                    lp.monitor.record_run()
-            self.check_rate(lp, lp.monitor, now)
+        if self.active:
+            self.run_scheduled(rt=False)

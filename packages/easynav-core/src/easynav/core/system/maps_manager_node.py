@@ -22,12 +22,5 @@ class MapsManagerNode(ComponentNode):
 
     def cycle(self) -> None:
         """Update each map when due. Non-RT thread."""
-        if not self.active:
-            return
-        now = self.now_seconds()
-        for lp in self.plugins:
-            if lp.plugin.is_time_to_run(now):
-                self.run_plugin(lp, "update")
-                if lp.monitor is not None:
-                    lp.monitor.record_run()
-            self.check_rate(lp, lp.monitor, now)
+        if self.active:
+            self.run_scheduled(rt=False)

@@ -33,23 +33,15 @@ class PlannerNode(ComponentNode):
         """Plan when due or forced by new goals. Non-RT thread."""
         if not self.active:
             return
-        now = self.now_seconds()
         goals = self.nav_state.get("goals") if self.nav_state.has("goals") else None
         force = goals is not self._planned_goals
-        for lp in self.plugins:
-            if lp.plugin.is_time_to_run(now) or force:
-                if force:
-                    lp.plugin.schedule.restart(now)
-                self._planned_goals = goals
-                self.run_plugin(lp, "update")
-                rejection = lp.plugin.take_goal_rejection()
-                if rejection and goals is not None and len(goals) > 0:
-                    self.get_logger().warning(f"goal rejected by {lp.alias}: {rejection}")
-                    self.system.services["requests"].post_abort(rejection)
-                if lp.monitor is not None:
-                    lp.monitor.record_run()
-                self._check_path(now)
-            self.check_rate(lp, lp.monitor, now)
+        self._planned_goals = goals
+        for lp, _ok in self.run_scheduled(rt=False, force=force):
+            rejection = lp.plugin.take_goal_rejection()
+            if rejection and goals is not None and len(goals) > 0:
+                self.get_logger().warning(f"goal rejected by {lp.alias}: {rejection}")
+                self.system.services["requests"].post_abort(rejection)
+            self._check_path(self.now_seconds())
 
     def _check_path(self, now: float) -> None:
         if not self.nav_state.has("path"):
