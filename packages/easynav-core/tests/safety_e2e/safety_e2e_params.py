@@ -85,7 +85,7 @@ SAFETY_MODE: dict[str, Any] = {
     "system_node.safety.plc_limits.max_linear_vel": 1.0,
     "system_node.safety.plc_limits.max_angular_vel": 2.0,
     "system_node.safety.heartbeat.period": 0.05,
-    "system_node.safety.status.timeout": 0.3,
+    "system_node.safety.status.timeout": 0.5,
     "system_node.safety.rt_monitor.max_period_factor": 20.0,
     "system_node.use_real_time": True,
     "controller_node.cmd_vel_keepalive_period": 0.05,

@@ -25,7 +25,7 @@ from easynav.core.types import DiagnosticLevel, Header, Pose, PoseStamped, Twist
 
 pytestmark = pytest.mark.ros
 
-STATUS_TIMEOUT = 0.2
+STATUS_TIMEOUT = 0.5  # s: the PLC publishes every 20 ms, but only while the test spins
 #: Reading the safety channel's state outside safety mode.
 READ_STATUS = {"system_node.safety.status.timeout": STATUS_TIMEOUT}
 
