@@ -6,6 +6,8 @@ and SCHED_FIFO are refused with a clear message where they are not permitted. Th
 
 from __future__ import annotations
 
+import os
+import shutil
 import subprocess
 import sys
 import threading
@@ -35,6 +37,14 @@ from safety_e2e_params import (
 pytestmark = pytest.mark.ros
 
 EASYNAV = str(Path(sys.executable).with_name("easynav"))
+
+#: The permission tests run easynav as a normal user would: root dropping its capabilities and
+#: limits with util-linux's setpriv and prlimit (which need root to do so).
+as_normal_user = pytest.mark.skipif(
+    os.geteuid() != 0 or not (shutil.which("setpriv") and shutil.which("prlimit")),
+    reason="needs root and util-linux setpriv/prlimit to run easynav without CAP_SYS_NICE, "
+    "CAP_IPC_LOCK and with finite RLIMIT_RTPRIO/RLIMIT_MEMLOCK",
+)
 
 
 class EasyNavProcess:
@@ -135,6 +145,7 @@ def test_late_rt_cycles_in_safety_mode_brake_and_exit_with_code_1(write_document
     assert plc.sent > 0
 
 
+@as_normal_user
 def test_without_permissions_safety_mode_and_memory_locking_are_refused_saying_how_to_grant_them(
     write_document,
 ):
@@ -167,6 +178,7 @@ def test_without_permissions_safety_mode_and_memory_locking_are_refused_saying_h
     assert "LimitMEMLOCK=infinity" in output and "ulimit -l" in output
 
 
+@as_normal_user
 def test_without_sched_fifo_outside_safety_mode_easynav_runs_with_a_warning(write_document):
     easynav = EasyNavProcess(
         ["run", "--duration", "0.5", write_document(system())],
