@@ -199,6 +199,29 @@ def test_the_sensor_watch_restarts_on_activation():
 
 
 # ── Non-RT case 2: localization lost ─────────────────────────────────────────────────────────
+def test_the_sensor_watch_starts_with_simulated_time():
+    # use_sim_time: the node clock reads 0 until the first /clock message, which may come
+    # seconds into the simulation (regression: it looked like sensors_timeout without data).
+    sim = simple()
+    sim.nav_state.set(
+        "diagnostics.sensors",
+        DiagnosticStatus(
+            DiagnosticLevel.WARN,
+            "sensors",
+            "no data: laser1",
+            "sensors_node",
+            {"no_data": "laser1", "stale": "", "sensors": "laser1"},
+        ),
+    )
+    sim.clock.t = 0.0
+    sim.manager.update(sim.nav_state)  # activated, no clock yet
+    sim.clock.t = 7.0  # the first /clock: the simulation has been running for 7 s
+    sim.run(1.0)
+    assert not sim.actions.of("request_shutdown")
+    sim.run(4.5)
+    assert len(sim.actions.of("request_shutdown")) == 1
+
+
 def test_localization_lost_holds_progress_and_rotates_until_relocalized():
     sim = simple()
     set_goal(sim.nav_state)

@@ -169,6 +169,11 @@ class SimpleRecoveryManager(RecoveryManagerBase):
     def update(self, nav_state: NavState) -> None:
         """Decide, most severe case first. Non-RT thread."""
         now = self.now()
+        if now <= 0.0:
+            # Simulated time before the first /clock message: nothing can be timed yet. The
+            # watches start with the clock, or the first message (seconds into the
+            # simulation) would look like sensors_timeout without data.
+            return
         if self._activated:
             self._activated = False
             self._newest_sensor_arrival = now  # sensors get sensors_timeout again
