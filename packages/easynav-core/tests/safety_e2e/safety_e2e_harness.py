@@ -18,7 +18,6 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import pytest
 from geometry_msgs.msg import Twist as TwistMsg
@@ -34,6 +33,7 @@ from rclpy.qos import (
 )
 
 from easynav.core.robot import RobotLimits
+from easynav.core.testing.dds_isolation import FAST_ANNOUNCEMENTS_PROFILE
 from easynav.core.testing.ros_fixtures import RosTestContext
 from easynav.core.types import Twist
 
@@ -326,11 +326,10 @@ class RosoutListener:
 
 def easynav_process_env() -> dict[str, str]:
     """The environment for an ``easynav`` subprocess: this process's (ROS domain, log directory)
-    plus a Fast DDS profile that announces its participant every 0.2 s instead of 3 s, so the
-    test's nodes discover it at once (see ``fastdds_fast_announcements.xml``).
+    with the Fast DDS profile that announces its participant every 0.2 s instead of 3 s, so the
+    test's nodes discover it at once (see ``easynav.core.testing.dds_isolation``).
     """
-    profile = Path(__file__).resolve().with_name("fastdds_fast_announcements.xml")
-    return {**os.environ, "FASTRTPS_DEFAULT_PROFILES_FILE": str(profile)}
+    return {**os.environ, "FASTRTPS_DEFAULT_PROFILES_FILE": str(FAST_ANNOUNCEMENTS_PROFILE)}
 
 
 @contextmanager

@@ -76,6 +76,7 @@ class SafetySupervisor:
         self.nav_state = system_node.nav_state
         self.freeze = ParameterFreeze()
         self.mode = False
+        self.configured_in_safety_mode = False
         self.fingerprint: ConfigurationFingerprint | None = None
         self.rt_monitor: RTCycleMonitor | None = None
         self.heartbeat: HeartbeatState | None = None
@@ -143,6 +144,7 @@ class SafetySupervisor:
         self._fingerprint(parameters)
         self.lock_memory = bool(p["safety.lock_memory"])
         if self.mode:
+            self.configured_in_safety_mode = True
             self.freeze.freeze()
 
     def effective_parameters(self) -> dict[str, dict[str, tuple[str, Any]]]:
@@ -232,7 +234,9 @@ class SafetySupervisor:
             )
 
     def cleanup(self) -> None:
-        if self.mode:
+        # Frozen again once EasyNav has been configured in safety mode; a first configure that
+        # failed leaves the parameters open, so the user can correct them.
+        if self.configured_in_safety_mode:
             self.freeze.freeze()
 
     # -- activation --------------------------------------------------------------------------------

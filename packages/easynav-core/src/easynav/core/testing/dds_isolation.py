@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import hashlib
 import os
+from pathlib import Path
+
+FAST_ANNOUNCEMENTS_PROFILE = Path(__file__).with_name("fastdds_fast_announcements.xml")
 
 
 def isolate_dds(run_id: str | None = None, worker: str | None = None) -> int:
@@ -20,4 +23,7 @@ def isolate_dds(run_id: str | None = None, worker: str | None = None) -> int:
     domain = (base + index) % 100 + 1
     os.environ["ROS_DOMAIN_ID"] = str(domain)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    # Announce participants every 0.2 s: a node that starts after a peer otherwise waits up to
+    # the peer's next announcement (~3 s) one time in eight.
+    os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(FAST_ANNOUNCEMENTS_PROFILE))
     return domain
