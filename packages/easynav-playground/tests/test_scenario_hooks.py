@@ -62,6 +62,7 @@ def test_a_released_robot_drives_on_with_the_command_it_has():
     sim.run_for(2.0)
     assert sim.robot.x > 0.5
     assert sim.odometry.x == pytest.approx(sim.robot.x, abs=1e-6)
+    assert sim.hold_events == [(0.0, True), (pytest.approx(1.0), False)]
 
 
 # ---------------------------------------------------------------------- scripted obstacles
@@ -199,6 +200,8 @@ def test_a_latched_hold_on_playground_hold_holds_the_robot_until_released(ros_be
         node.stop()
     data = json.loads(record.read_text())
     assert data["obstacles"] == [{"name": "person", "started_at": 0.0}]
+    (held_at, held), (released_at, released) = data["holds"]
+    assert (held, released) == (True, False) and 0.0 <= held_at < released_at
 
 
 def _wait(predicate, timeout=10.0):

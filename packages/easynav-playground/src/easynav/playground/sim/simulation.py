@@ -35,7 +35,8 @@ class Simulation:
 
     A robot :attr:`held` in place (:meth:`set_held`, wheels blocked: a test scenario) does not
     move whatever it is commanded; its velocities are zero and the odometry sees no motion.
-    Commands are still taken, so it drives on when released.
+    Commands are still taken, so it drives on when released. :attr:`hold_events` lists
+    ``(stamp, held)`` for every change, stamped with the first step it applied to.
 
     The laser is mounted at ``laser_offset`` ``(x, y, yaw)`` in the robot frame.
 
@@ -81,6 +82,8 @@ class Simulation:
         self._command_lock = threading.Lock()
         self._pending_command: tuple[float, float] | None = None
         self._held = False
+        self._was_held = False
+        self.hold_events: list[tuple[float, bool]] = []
         self.commands_received = 0
         self._next_scan = scanner.period
         self._next_odom = self.odom_period
@@ -139,6 +142,9 @@ class Simulation:
         if command is not None:
             robot.set_command(command[0], command[1], now)
 
+        if held != self._was_held:
+            self._was_held = held
+            self.hold_events.append((now, held))
         x, y, yaw, v, w = robot.next_state(dt, now)
         what = None if held else self.checker.colliding_with(x, y, self.obstacles)
         if held:
