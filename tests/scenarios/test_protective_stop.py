@@ -1,0 +1,100 @@
+"""Scenario 3: a long protective stop of the safety channel in the middle of a mission.
+
+The test stands in for the certified safety channel: it publishes SafetyStatus on
+``easynav_safety_status`` every 50 ms (system_node reads it: ``safety.status.timeout`` 1 s).
+While the robot drives, the channel signals a protective stop and keeps it. EasyNav commands zero
+and keeps the mission; SafetyChannelEvaluator reports WARN, then ERROR once the stop lasted
+``max_stop_time`` (4 s here; the example's 60 s would only make the test longer), and the
+example's HumanAssistanceRecovery asks for help. When the channel releases the stop, the robot
+goes on by itself and reaches the goal.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from scenario_run import ScenarioRun, scenario_params, speed_up, world_file
+
+from easynav.core.goals.goal_client_state import GoalClientState
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.ros,
+    pytest.mark.timeout(300),
+    # One scenario at a time (--dist loadgroup): each takes about a core at 2x real time.
+    pytest.mark.xdist_group("easynav_scenarios"),
+]
+
+START = (5.6, 3.4, 0.0)
+GOAL = (8.6, 3.4, 0.0)
+MAX_STOP_TIME = 4.0
+EXTRA_STOP = 2.0  # s the stop lasts beyond the ERROR
+WARN, ERROR = 1, 2
+
+
+def test_a_long_protective_stop_is_an_error_the_goal_stays_and_the_robot_goes_on(tmp_path):
+    params = scenario_params(
+        **{
+            "system_node.safety.status.timeout": 1.0,
+            "recovery_node.recovery_manager.safety_channel.max_stop_time": MAX_STOP_TIME,
+        }
+    )
+    world = world_file(tmp_path, "stop", START)
+    with ScenarioRun(tmp_path / "run", world, params, speed_up=speed_up()) as run:
+        run.start_safety_channel(period=0.05)
+        run.wait_for_goal_manager()
+        run.send_goals([GOAL])
+        run.spin_until(
+            lambda: math.dist(run.position(), START[:2]) > 0.5, 60.0, "the robot to drive off"
+        )
+        run.safety_protective_stop = True
+        stop_at = run.sim_time()
+        stop_pose = run.position()
+        error = run.spin_until(
+            lambda: run.monitor.first_diagnostic("safety_channel", ERROR, since=stop_at),
+            (MAX_STOP_TIME + 10.0) / speed_up() + 20.0,
+            "the safety channel ERROR",
+        )
+        state_at_error = run.client.get_state()
+        run.spin_for_sim(EXTRA_STOP)
+        run.safety_protective_stop = False
+        released_at = run.sim_time()
+        state, message = run.wait_for_end(timeout=60.0)
+        ended_at = run.sim_time()
+        warn = run.monitor.first_diagnostic("safety_channel", WARN, since=stop_at)
+        back_ok = run.monitor.first_diagnostic("safety_channel", 0, since=released_at)
+        reports = [r.message for r in run.monitor.reports if r.stamp >= stop_at]
+        commands = list(run.monitor.commands)
+
+    # WARN while stopped, ERROR once the stop lasted max_stop_time; the goal stayed active.
+    assert warn is not None and warn.stamp < error.stamp
+    stopped_for = error.stamp - stop_at
+    assert MAX_STOP_TIME <= stopped_for < MAX_STOP_TIME + 3.0, stopped_for
+    assert "for too long" in error.message, error.message
+    assert state_at_error is GoalClientState.ACCEPTED_AND_NAVIGATING
+    # The example's HumanAssistanceRecovery asked for help while the ERROR stood (it may have
+    # been started by another ERROR first: it waits for every ERROR it handles to clear).
+    asked = [r for r in reports if r.startswith("mitigation human_assistance selected")]
+    assert asked, reports
+
+    # The robot stood still during the stop: EasyNav's command was zero.
+    moved = [
+        math.dist((x, y), stop_pose)
+        for _, x, y in run.true_poses_between(stop_at + 0.5, released_at)
+    ]
+    assert moved and max(moved) < 0.1, f"the robot went {max(moved):.3f} m after the stop"
+    assert run.truth.distance_driven(stop_at + 1.0, released_at) < 0.005
+    in_force = [vx for t, vx, _ in commands if t <= released_at]
+    assert in_force[-1] == 0.0
+
+    # Released: the channel is OK again and the robot finishes the mission by itself.
+    assert back_ok is not None
+    assert state == "NAVIGATION_FINISHED", (state, message)
+    after = run.true_poses_between(released_at, ended_at)
+    assert math.dist(after[-1][1:], GOAL[:2]) < 0.3
+    print(
+        f"\nprotective stop at t={stop_at:.1f} s, braked within "
+        f"{max(moved):.3f} m; ERROR after {stopped_for:.1f} s (max_stop_time {MAX_STOP_TIME} s); "
+        f"released at t={released_at:.1f} s; goal reached {ended_at - released_at:.1f} s later"
+    )
