@@ -8,6 +8,7 @@ import copy
 import json
 import math
 import os
+import shutil
 import sys
 import time
 from collections.abc import Callable
@@ -18,7 +19,6 @@ import yaml
 
 from easynav.playground.demo.child_process import ChildProcess
 from easynav.playground.demo.demo import DEFAULT_PARAMS as PLAYGROUND_PARAMS
-from easynav.playground.demo.demo import _easynav_command
 from easynav.playground.demo.params_patch import derive_params
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.world_description import WORLDS_DIR, WorldDescription
@@ -174,7 +174,7 @@ class ScenarioRun:
             self.children.append(
                 ChildProcess(
                     "easynav",
-                    [*_easynav_command(), "run", str(self.params_path)],
+                    [_easynav_command(), "run", str(self.params_path)],
                     env,
                     self.run_dir / "easynav.log",
                 )
@@ -390,6 +390,15 @@ class ScenarioRun:
         """Smallest robot-edge gap to walls and obstacles between two stamps (after the run)."""
         values = [c for t, c in self.truth.clearances if start <= t <= end]
         return min(values, default=math.nan)
+
+
+def _easynav_command() -> str:
+    """The ``easynav`` command of this environment (beside the interpreter, else on PATH)."""
+    beside = Path(sys.executable).parent / "easynav"
+    found = str(beside) if beside.exists() else shutil.which("easynav")
+    if not found:
+        raise ScenarioError("the 'easynav' command is neither beside Python nor on PATH")
+    return found
 
 
 def _parameter_args(values: dict[str, Any]) -> list[str]:
