@@ -107,15 +107,17 @@ def test_node_publishes_sensors_clock_tf_and_moves_on_cmd_vel(ros_bed, tmp_path)
         start_x = truth.pose.pose.position.x
         command = Twist()
         command.linear.x = 0.3
-        t_end = time.monotonic() + 1.0
-        while time.monotonic() < t_end:
+        # Keep commanding until the base has sped up and moved (simulated time runs slower than
+        # intended on a loaded machine: wait for the effect, not for a wall-clock time).
+        def moved() -> bool:
             probe.cmd_pub.publish(command)
-            time.sleep(0.05)
-        assert wait_for(
-            lambda: received["/ground_truth"][-1].pose.pose.position.x > start_x + 0.2, 10.0
-        )
-        assert received["/odom"][-1].pose.pose.position.x > 0.2
-        assert received["/odom"][-1].twist.twist.linear.x > 0.2
+            return (
+                received["/ground_truth"][-1].pose.pose.position.x > start_x + 0.2
+                and received["/odom"][-1].pose.pose.position.x > 0.2
+                and received["/odom"][-1].twist.twist.linear.x > 0.2
+            )
+
+        assert wait_for(moved, 20.0)
     finally:
         node.stop()
     data = json.loads(record.read_text())
