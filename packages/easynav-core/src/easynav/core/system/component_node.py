@@ -220,6 +220,10 @@ class ComponentNode(LifecycleNode):
         Returns ``(plugin, ok)`` for each plugin that ran. Thread: the loop of ``rt``.
         """
         now = self.now_seconds()
+        if now <= 0.0:
+            # Simulated time that has not started (no /clock yet for this node): time-based
+            # plugins would take the jump to the first clock message for seconds without data.
+            return []
         method = "update_rt" if rt else "update"
         ran = []
         for lp in self.plugins:

@@ -101,7 +101,7 @@ class RecoveryNode(ComponentNode):
 
     def cycle_rt(self) -> bool:
         """The manager's fast reactions; True when it commanded the robot. RT thread."""
-        if not self.active:
+        if not self.active or self.now_seconds() <= 0.0:  # simulated time not started yet
             return False
         commanded = False
         for lp in self.plugins:
@@ -115,7 +115,7 @@ class RecoveryNode(ComponentNode):
 
     def cycle(self) -> None:
         """The manager's diagnosis and decisions. Non-RT thread."""
-        if not self.active:
+        if not self.active or self.now_seconds() <= 0.0:  # simulated time not started yet
             return
         for lp in self.plugins:
             self.run_plugin(lp, "update")
