@@ -6,10 +6,7 @@ Aliases are unique across nodes, so diagnostics are ``diagnostics.<alias>.*``.
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
-
-import yaml
 
 from easynav.core.robot import RobotLimits
 from easynav.core.testing.system_fixtures import system_params
@@ -86,39 +83,3 @@ def inject(plugin: tuple[str, str, str], fault: str, fault_after: int = 0, **par
     return {f"{node}.{alias}.{name}": value for name, value in values.items()}
 
 
-# Plain scalars that ROS's YAML parser reads as numbers, booleans or null, not as strings.
-_NOT_STRINGS_WHEN_PLAIN = {
-    "nan",
-    ".nan",
-    "inf",
-    ".inf",
-    "-inf",
-    "-.inf",
-    "true",
-    "false",
-    "yes",
-    "no",
-    "on",
-    "off",
-    "null",
-    "~",
-    "",
-}
-
-
-class _QuotingDumper(yaml.SafeDumper):
-    """Quotes the strings ROS would otherwise read as other types (``fault: nan``)."""
-
-
-def _represent_str(dumper: yaml.SafeDumper, value: str) -> yaml.Node:
-    style = '"' if value.lower() in _NOT_STRINGS_WHEN_PLAIN else None
-    return dumper.represent_scalar("tag:yaml.org,2002:str", value, style=style)
-
-
-_QuotingDumper.add_representer(str, _represent_str)
-
-
-def write_params(path: Path, document: dict[str, Any]) -> str:
-    """Write a params document as YAML that ROS reads back with the same types; its path."""
-    path.write_text(yaml.dump(document, Dumper=_QuotingDumper, sort_keys=False))
-    return str(path)

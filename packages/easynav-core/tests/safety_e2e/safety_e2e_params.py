@@ -8,10 +8,7 @@ time; the limits are fast ramps (0.1 s from full speed to zero, 0.15 s back).
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
-
-import yaml
 
 from easynav.core.robot import RobotLimits
 from easynav.core.testing.system_fixtures import system_params
@@ -113,39 +110,3 @@ def fault(fault_name: str, fault_after: int = 0, node: str = "controller_node", 
     return {f"{node}.{alias}.{name}": value for name, value in values.items()}
 
 
-# Plain scalars that ROS's params parser reads as numbers, booleans or null, not as strings.
-_NOT_STRINGS_WHEN_PLAIN = {
-    "nan",
-    ".nan",
-    "inf",
-    ".inf",
-    "-inf",
-    "-.inf",
-    "true",
-    "false",
-    "yes",
-    "no",
-    "on",
-    "off",
-    "null",
-    "~",
-    "",
-}
-
-
-class _QuotingDumper(yaml.SafeDumper):
-    """Quotes the strings ROS would read as other types (``fault: nan`` is a string here)."""
-
-
-def _represent_str(dumper: yaml.SafeDumper, value: str) -> yaml.Node:
-    ambiguous = value.lower() in _NOT_STRINGS_WHEN_PLAIN or "\n" in value
-    return dumper.represent_scalar("tag:yaml.org,2002:str", value, style='"' if ambiguous else None)
-
-
-_QuotingDumper.add_representer(str, _represent_str)
-
-
-def write_params(path: Path, document: dict[str, Any]) -> str:
-    """Write ``document`` as YAML that ROS reads back with the same types; returns the path."""
-    path.write_text(yaml.dump(document, Dumper=_QuotingDumper, sort_keys=False))
-    return str(path)

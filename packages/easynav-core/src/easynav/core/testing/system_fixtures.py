@@ -76,15 +76,19 @@ _ParamsDumper.add_representer(
 )
 
 
+def write_params(path: Path, document: dict[str, Any]) -> str:
+    """Write a params document as YAML that ROS reads back with the same types; its path."""
+    Path(path).write_text(yaml.dump(document, Dumper=_ParamsDumper, sort_keys=False))
+    return str(path)
+
+
 @pytest.fixture
 def params_file(tmp_path: Path) -> Callable[[dict[str, Any]], str]:
     """``params_file(document) -> path`` of a temporary YAML file."""
     counter = iter(range(10_000))
 
     def write(document: dict[str, Any]) -> str:
-        path = tmp_path / f"params_{next(counter)}.yaml"
-        path.write_text(yaml.dump(document, Dumper=_ParamsDumper, sort_keys=False))
-        return str(path)
+        return write_params(tmp_path / f"params_{next(counter)}.yaml", document)
 
     return write
 
