@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import logging
+from abc import ABC, abstractmethod
 from typing import Any, ClassVar
 
 from easynav.core.sensors.warning_throttle import WarningThrottle
@@ -41,7 +42,7 @@ def import_message_class(type_name: str) -> type:
     return cls
 
 
-class PerceptionHandler:
+class PerceptionHandler(ABC):
     """Base of the perception handlers (entry-point group ``easynav.perception_handlers``).
 
     A subclass sets ``ros_message_type`` (full type name, e.g. ``"sensor_msgs/msg/LaserScan"``)
@@ -69,12 +70,12 @@ class PerceptionHandler:
         """The ROS message class to subscribe with (imported on demand)."""
         return import_message_class(self.ros_message_type)
 
-    def configure(self, sensor_id: str, parameters: Any, node: Any) -> None:
+    def configure(self, sensor_id: str, parameters: Any, node: Any) -> None:  # noqa: B027
         """Read handler-specific parameters ``<sensor_id>.<name>`` (none by default)."""
 
+    @abstractmethod
     def to_perception(self, msg: Any, sensor_id: str) -> Any:
         """The perception of one message (``valid`` and ``new_data`` left True)."""
-        raise NotImplementedError(f"{type(self).__name__} does not implement to_perception")
 
     def warn(self, sensor_id: str, text: str, kind: str = "") -> None:
         """A warning naming the sensor, at most once per 10 s per sensor and ``kind``."""
