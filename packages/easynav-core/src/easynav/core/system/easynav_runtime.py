@@ -132,8 +132,8 @@ class EasyNavRuntime:
             self.error = node.error_message or "activate failed"
             return False
         # Objects alive now (nodes, plugins, maps) are never garbage: keep the cyclic collector
-        # from walking them during cycles.
-        gc.collect()
+        # from walking them during cycles. (No explicit collection first: in a test process a
+        # collection here once ran a finalizer of an earlier test's ROS objects for minutes.)
         gc.freeze()
         self._froze_gc = True
         self.logger.info("EasyNav is active")
