@@ -6,6 +6,7 @@ Aliases are unique across nodes, so diagnostics are ``diagnostics.<alias>.*``.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from easynav.core.robot import RobotLimits
@@ -44,15 +45,7 @@ BASE: dict[str, Any] = {
             "linear_vel": LINEAR_VEL,
             "angular_vel": ANGULAR_VEL,
         },
-        "robot_limits": {
-            "max_linear_vel": LIMITS.max_linear_vel,
-            "min_linear_vel": LIMITS.min_linear_vel,
-            "max_angular_vel": LIMITS.max_angular_vel,
-            "max_linear_acc": LIMITS.max_linear_acc,
-            "max_linear_decel": LIMITS.max_linear_decel,
-            "max_angular_acc": LIMITS.max_angular_acc,
-            "max_angular_decel": LIMITS.max_angular_decel,
-        },
+        "robot_limits": dataclasses.asdict(LIMITS),
         "cmd_timeout": CMD_TIMEOUT,
         # Commands are republished at least this often, so what reaches the robot can be
         # watched even while it does not change.

@@ -8,6 +8,7 @@ time; the limits are fast ramps (0.1 s from full speed to zero, 0.15 s back).
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from easynav.core.robot import RobotLimits
@@ -45,15 +46,7 @@ BASE: dict[str, Any] = {
             "linear_vel": LINEAR_VEL,
             "angular_vel": ANGULAR_VEL,
         },
-        "robot_limits": {
-            "max_linear_vel": LIMITS.max_linear_vel,
-            "min_linear_vel": LIMITS.min_linear_vel,
-            "max_angular_vel": LIMITS.max_angular_vel,
-            "max_linear_acc": LIMITS.max_linear_acc,
-            "max_linear_decel": LIMITS.max_linear_decel,
-            "max_angular_acc": LIMITS.max_angular_acc,
-            "max_angular_decel": LIMITS.max_angular_decel,
-        },
+        "robot_limits": dataclasses.asdict(LIMITS),
         "cmd_timeout": CMD_TIMEOUT,
         # Stamped commands: the stamp is the node clock of the RT cycle that computed each one,
         # so every change between two commands can be checked against the limits exactly.
