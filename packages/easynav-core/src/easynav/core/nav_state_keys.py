@@ -1,39 +1,84 @@
-"""The NavState keys shared between components (REFERENCE.md §3), in one ROS-free place."""
+"""The NavState keys shared between components, declared once with their types.
+
+Each constant is a :class:`NavStateKey`: a ``str`` (so ``nav_state.get(PATH)`` and any code that
+uses the plain name keep working) that also carries the value's type and a description, which
+``easynav plugins --describe`` and the README tables show. A plugin lists the keys it reads and
+writes in ``READS`` / ``WRITES`` and uses these constants instead of string literals.
+"""
 
 from __future__ import annotations
 
-ROBOT_POSE = "robot_pose"
-"""Odometry: the localizer's pose in the map frame, covariance and measured twist."""
 
-GOALS = "goals"
-"""Goals: the waypoints still to visit; empty when idle (goal manager)."""
+class NavStateKey(str):
+    """A NavState key: its name (the ``str`` itself), the type of its value, a description."""
 
-NAVIGATION_STATE = "navigation_state"
-"""str: "IDLE" or "ACTIVE" (goal manager)."""
+    value_type: str
+    description: str
 
-NAVIGATION_PAUSED = "navigation_paused"
-"""bool: a client paused the navigation; the velocity mux outputs zero (goal manager)."""
+    def __new__(cls, name: str, value_type: str | type = "", description: str = "") -> NavStateKey:
+        key = super().__new__(cls, name)
+        key.value_type = value_type if isinstance(value_type, str) else value_type.__name__
+        key.description = description
+        return key
 
-PATH = "path"
-"""Path: the planner's path; empty means "no plan"."""
+    def __reduce__(self):
+        return (NavStateKey, (str(self), self.value_type, self.description))
 
-CMD_VEL = "cmd_vel"
-"""TwistStamped: the controller's command (stamp every new one); the one published may differ."""
 
-PROPOSAL_TAKEOVER = "cmd_vel.proposal.takeover"
-"""Twist: the recovery system drives the robot this RT cycle (smoothed)."""
+ROBOT_POSE = NavStateKey(
+    "robot_pose",
+    "Odometry",
+    "the localizer's pose in the map frame, covariance and measured twist.",
+)
 
-PROPOSAL_OVERRIDE = "cmd_vel.proposal.override"
-"""Twist: the recovery system's emergency command this RT cycle (published as is)."""
+GOALS = NavStateKey(
+    "goals", "Goals", "the waypoints still to visit; empty when idle (goal manager)."
+)
 
-SAFETY_STATUS = "safety_status"
-"""SafetyChannelState: only when system_node reads the safety channel."""
+NAVIGATION_STATE = NavStateKey("navigation_state", "str", '"IDLE" or "ACTIVE" (goal manager).')
 
-MOTION_INHIBITED = "motion_inhibited"
-"""bool: in safety mode, the robot pose is not usable; the command brakes to zero."""
+NAVIGATION_PAUSED = NavStateKey(
+    "navigation_paused",
+    "bool",
+    "a client paused the navigation; the velocity mux outputs zero (goal manager).",
+)
 
-CONFIGURATION_HASH = "configuration_hash"
-"""str: SHA-256 of the configuration (safety supervisor)."""
+PATH = NavStateKey("path", "Path", 'the planner\'s path; empty means "no plan".')
 
-RECONFIGURED_PARAMETERS = "reconfigured_parameters"
-"""list[str]: ``node/parameter`` changed through ``request_reconfigure``."""
+CMD_VEL = NavStateKey(
+    "cmd_vel",
+    "TwistStamped",
+    "the controller's command (stamp every new one); the one published may differ.",
+)
+
+PROPOSAL_TAKEOVER = NavStateKey(
+    "cmd_vel.proposal.takeover",
+    "Twist",
+    "the recovery system drives the robot this RT cycle (smoothed).",
+)
+
+PROPOSAL_OVERRIDE = NavStateKey(
+    "cmd_vel.proposal.override",
+    "Twist",
+    "the recovery system's emergency command this RT cycle (published as is).",
+)
+
+SAFETY_STATUS = NavStateKey(
+    "safety_status", "SafetyChannelState", "only when system_node reads the safety channel."
+)
+
+MOTION_INHIBITED = NavStateKey(
+    "motion_inhibited",
+    "bool",
+    "in safety mode, the robot pose is not usable; the command brakes to zero.",
+)
+
+CONFIGURATION_HASH = NavStateKey(
+    "configuration_hash", "str", "SHA-256 of the configuration (safety supervisor)."
+)
+
+RECONFIGURED_PARAMETERS = NavStateKey(
+    "reconfigured_parameters",
+    "list[str]",
+    "``node/parameter`` changed through ``request_reconfigure``.",
+)

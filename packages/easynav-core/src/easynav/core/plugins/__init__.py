@@ -1,6 +1,13 @@
 """Plugin base classes, scheduling, rate monitoring and discovery."""
 
 from easynav.core.plugins.controller_method_base import ControllerMethodBase
+from easynav.core.plugins.declarations import (
+    Param,
+    ParameterValueError,
+    ParameterValues,
+    Topic,
+    read_parameters,
+)
 from easynav.core.plugins.localizer_method_base import LocalizerMethodBase
 from easynav.core.plugins.maps_manager_base import MapsManagerBase
 from easynav.core.plugins.method_base import MethodBase, PluginConfigurationError
@@ -16,6 +23,9 @@ __all__ = [
     "LocalizerMethodBase",
     "MapsManagerBase",
     "MethodBase",
+    "Param",
+    "ParameterValueError",
+    "ParameterValues",
     "ParameterAccess",
     "PlannerMethodBase",
     "PluginConfigurationError",
@@ -24,4 +34,6 @@ __all__ = [
     "RateSchedule",
     "RecoveryActions",
     "RecoveryManagerBase",
+    "Topic",
+    "read_parameters",
 ]

@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
-import math
-from typing import Any
+from typing import Any, ClassVar
 
+from easynav.core.plugins.declarations import (
+    Param,
+    ParameterValueError,
+    ParameterValues,
+    Topic,
+    merge_declarations,
+    read_parameters,
+)
 from easynav.core.plugins.plugin_context import PluginContext
 from easynav.core.plugins.rate_monitor import RateMonitor
 from easynav.core.plugins.rate_schedule import RateSchedule
@@ -15,13 +22,23 @@ class PluginConfigurationError(RuntimeError):
     """A plugin cannot be configured; the message names the parameter."""
 
 
+#: Parameters every plugin has: how often its RT and non-RT parts run.
+COMMON_PARAMETERS = (
+    Param("rt_freq", 10.0, "frequency of the RT part (update_rt)", "Hz", gt=0.0),
+    Param("freq", 10.0, "frequency of the non-RT part (update)", "Hz", gt=0.0),
+)
+
+
 class MethodBase:
     """Base of every plugin.
 
-    ``initialize(context, plugin_name)`` declares-if-absent and reads ``<plugin_name>.rt_freq``
-    and ``<plugin_name>.freq`` (10.0 each), checks them (finite, > 0, not above the system
-    cycle's frequency) and calls :meth:`on_initialize`. It may be called again on the same object
-    or on a fresh one after a cleanup (runtime reconfiguration).
+    A plugin declares its parameters once, as data, in ``PARAMETERS`` (see
+    :class:`~easynav.core.plugins.declarations.Param`), and reads them as ``self.params.<name>``.
+    ``initialize(context, plugin_name)`` declares every parameter on the host node under
+    ``<plugin_name>.``, converts and validates it (an error names parameter, value and rule),
+    reads deprecated names with a warning, checks ``rt_freq`` and ``freq`` (10.0 each) against
+    the system cycle's frequencies and calls :meth:`on_initialize`. It may be called again on the
+    same object or on a fresh one after a cleanup (runtime reconfiguration).
 
     Thread contract: ``initialize`` runs in the configuring thread while no loop runs; RT methods
     (``update_rt``) run in the RT loop thread, non-RT ones (``update``) in the non-RT loop thread.
@@ -33,6 +50,15 @@ class MethodBase:
     HAS_RT_UPDATE = False
     HAS_UPDATE = False
 
+    #: The plugin's own parameters (see :class:`Param`); a subclass's replace its bases' of the
+    #: same name. ``rt_freq`` and ``freq`` are common to every plugin.
+    PARAMETERS: ClassVar[tuple[Param, ...]] = ()
+    #: Topics the plugin publishes or subscribes to on its host node.
+    TOPICS: ClassVar[tuple[Topic, ...]] = ()
+    #: NavState keys the plugin reads and writes (NavStateKey constants).
+    READS: ClassVar[tuple[Any, ...]] = ()
+    WRITES: ClassVar[tuple[Any, ...]] = ()
+
     def __init__(self) -> None:
         self.context: PluginContext = PluginContext()
         self.plugin_name = ""
@@ -42,14 +68,74 @@ class MethodBase:
         self.schedule = RateSchedule(10.0)
         self.rt_rate_monitor: RateMonitor | None = None
         self.rate_monitor: RateMonitor | None = None
+        self.params = ParameterValues()
+
+    # -- declarations --------------------------------------------------------------------------
+    @classmethod
+    def parameter_declarations(cls) -> tuple[Param, ...]:
+        """Every parameter of this plugin class: the common ones, then each class's own
+        (base classes first; a subclass's declaration replaces a base's of the same name)."""
+        groups = [COMMON_PARAMETERS]
+        for klass in reversed(cls.__mro__):
+            own = klass.__dict__.get("PARAMETERS")
+            if own:
+                groups.append(own)
+        return merge_declarations(groups)
+
+    @classmethod
+    def parameter_declaration(cls, name: str) -> Param | None:
+        """The declaration of ``name`` (current or deprecated name), or None."""
+        for param in cls.parameter_declarations():
+            if name == param.name or name in param.deprecated:
+                return param
+        return None
+
+    def validate_parameter(self, name: str, value: Any) -> Any:
+        """A runtime change of ``<alias>.<name>`` checked against its declaration: the converted
+        value, or :class:`ParameterValueError` with the reason (the host refuses the change)."""
+        param = self.parameter_declaration(name)
+        full = f"{self.plugin_name}.{name}"
+        if param is None:
+            raise ParameterValueError(f"{full}: unknown parameter")
+        if not param.dynamic:
+            raise ParameterValueError(f"{full}: cannot change at runtime (reconfigure instead)")
+        converted = param.convert(value, full)
+        if param.name in ("rt_freq", "freq"):
+            self._check_frequency(param.name, converted)
+        return converted
+
+    def apply_parameter(self, name: str, value: Any) -> None:
+        """Store a validated runtime change and tell the plugin (:meth:`on_parameter_changed`)."""
+        param = self.parameter_declaration(name)
+        key = param.name if param is not None else name
+        self.params.set(key, value)
+        if key == "rt_freq":
+            self.rt_freq = value
+            self.rt_schedule = RateSchedule(value)
+        elif key == "freq":
+            self.freq = value
+            self.schedule = RateSchedule(value)
+        self.on_parameter_changed(key, value)
+
+    def on_parameter_changed(self, name: str, value: Any) -> None:
+        """A parameter changed at runtime (already validated and stored in ``self.params``).
+        Plugins that read ``self.params`` every cycle need nothing here; those that derive
+        state from a parameter rebuild it."""
 
     # -- lifecycle ---------------------------------------------------------------------------
     def initialize(self, context: PluginContext, plugin_name: str) -> None:
         """Read the common parameters, then :meth:`on_initialize`."""
         self.context = context
         self.plugin_name = plugin_name
-        self.rt_freq = self._frequency("rt_freq", context.system_rt_freq, "system_node.rt_freq")
-        self.freq = self._frequency("freq", context.system_freq, "system_node.freq")
+        try:
+            self.params = read_parameters(
+                self.parameter_declarations(), context.parameters, plugin_name,
+                warn=lambda message: self.logger.warning(message),
+            )
+        except ParameterValueError as exc:
+            raise PluginConfigurationError(str(exc)) from None
+        self.rt_freq = self._check_frequency("rt_freq", self.params.rt_freq)
+        self.freq = self._check_frequency("freq", self.params.freq)
         self.rt_schedule = RateSchedule(self.rt_freq)
         self.schedule = RateSchedule(self.freq)
         self.on_initialize()
@@ -66,19 +152,17 @@ class MethodBase:
     def on_deactivate(self) -> None:
         """EasyNav becomes inactive (its cycles stop). Lifecycle thread, loops not cycling."""
 
-    def _frequency(self, name: str, system_value: float, system_name: str) -> float:
-        full = f"{self.plugin_name}.{name}"
-        value = self.get_parameter(name, 10.0)
-        try:
-            value = float(value)
-        except (TypeError, ValueError):
-            raise PluginConfigurationError(f"{full} = {value!r} is not a number") from None
-        if not math.isfinite(value) or value <= 0.0:
-            raise PluginConfigurationError(f"{full} = {value} must be finite and > 0")
+    def _check_frequency(self, name: str, value: float) -> float:
+        # A plugin cannot run faster than the cycle that schedules it.
+        system_value, system_name = (
+            (self.context.system_rt_freq, "system_node.rt_freq") if name == "rt_freq"
+            else (self.context.system_freq, "system_node.freq")
+        )
         if value > system_value:
             raise PluginConfigurationError(
-                f"{full} = {value:g} Hz exceeds {system_name} = {system_value:g} Hz: a component "
-                f"cannot run faster than the cycle that schedules it"
+                f"{self.plugin_name}.{name} = {value:g} Hz exceeds {system_name} = "
+                f"{system_value:g} Hz: a component cannot run faster than the cycle that "
+                f"schedules it"
             )
         return value
 

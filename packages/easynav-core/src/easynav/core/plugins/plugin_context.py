@@ -26,6 +26,10 @@ class ParameterAccess:
         """Change a declared parameter's value."""
         raise NotImplementedError
 
+    def is_set(self, name: str) -> bool:
+        """Whether the user gave ``name`` a value (params file, command line): not a default."""
+        raise NotImplementedError
+
 
 class DictParameters(ParameterAccess):
     """Parameters held in a dict: ``DictParameters({"simple.k_rot": 0.5})``."""
@@ -42,6 +46,9 @@ class DictParameters(ParameterAccess):
     def set(self, name: str, value: Any) -> None:
         self.values[name] = value
         self.declared[name] = value
+
+    def is_set(self, name: str) -> bool:
+        return name in self.values
 
 
 def _monotonic_seconds() -> float:

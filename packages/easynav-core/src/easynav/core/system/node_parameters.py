@@ -74,6 +74,9 @@ class NodeParameters(ParameterAccess):
         if not result.successful:
             raise ParameterError(f"{self._node.get_name()}.{name}: {result.reason}")
 
+    def is_set(self, name: str) -> bool:
+        return name in self._node._parameter_overrides
+
     def get(self, name: str) -> Any:
         """The value of a declared parameter."""
         return self._node.get_parameter(name).value

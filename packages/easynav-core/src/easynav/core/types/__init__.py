@@ -3,6 +3,13 @@
 ROS messages exist only at the node boundary (``easynav.core.ros.converters``).
 """
 
+from easynav.core.types.costmap_2d import (
+    FREE_SPACE,
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    Costmap2D,
+)
 from easynav.core.types.diagnostic import DiagnosticLevel, DiagnosticStatus
 from easynav.core.types.goals import Goals
 from easynav.core.types.header import Header
@@ -15,6 +22,11 @@ from easynav.core.types.transform import Transform, TransformStamped
 from easynav.core.types.twist import Twist, TwistStamped
 
 __all__ = [
+    "FREE_SPACE",
+    "INSCRIBED_INFLATED_OBSTACLE",
+    "LETHAL_OBSTACLE",
+    "NO_INFORMATION",
+    "Costmap2D",
     "DiagnosticLevel",
     "DiagnosticStatus",
     "Goals",
