@@ -20,9 +20,8 @@ pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(900)]
 
 
 def _domain_id() -> int:
-    # A domain of its own per xdist worker (the demo's default is derived from the pid).
-    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
-    return 150 + int(worker.removeprefix("gw") or 0) % 50
+    # The domain this test process reserved (repository conftest): no other process uses it.
+    return int(os.environ["ROS_DOMAIN_ID"])
 
 
 def test_demo_drives_the_home_tour_without_collision(tmp_path):

@@ -60,8 +60,10 @@ def _easynav_command() -> list[str]:
 
 
 def _free_domain_id() -> int:
-    """A ROS domain id for this run, derived from the pid (1..100; 0 is the usual default)."""
-    return 1 + os.getpid() % 100
+    """A ROS domain id no other process of this machine holds (reserved until this one exits)."""
+    from easynav.core.testing.dds_isolation import reserve_domain
+
+    return reserve_domain(f"demo/{os.getpid()}")
 
 
 def run_demo(
