@@ -68,7 +68,9 @@ if [ "$(cat "$STAMPS/packages" 2>/dev/null)" != "$step" ]; then
   for pkg in packages/*/; do
     name=$(basename "$pkg")
     [ "$name" = easynav-interfaces ] && continue
-    args+=(-e "$pkg")
+    # "[all]": every optional extra of the package (OMPL, GTSAM, numba, ...): the test suite
+    # exercises them all. A package without extras gets a harmless "no extra 'all'" note.
+    if grep -q '^all = ' "$pkg/pyproject.toml"; then args+=(-e "$pkg[all]"); else args+=(-e "$pkg"); fi
   done
   pip_install --no-build-isolation "${args[@]}"
   echo "$step" > "$STAMPS/packages"
