@@ -90,16 +90,16 @@ RPP_PARAMETERS = (
 )
 
 #: Deprecated limit parameters: RobotLimits field and how each caps it.
-RPP_LIMIT_CAPS = {
-    "max_linear_vel": ("max_linear_vel", "max"),
-    "min_linear_vel": ("min_linear_vel", "min"),
-    "max_angular_vel": ("max_angular_vel", "max"),
-    "min_angular_vel": ("max_angular_vel", "neg"),
-    "max_linear_accel": ("max_linear_acc", "max"),
-    "max_linear_decel": ("max_linear_decel", "max"),
-    "max_angular_accel": ("max_angular_acc", "max"),
-    "max_angular_decel": ("max_angular_decel", "max"),
-}
+RPP_LIMIT_CAPS = (
+    ("max_linear_vel", "max_linear_vel", "max"),
+    ("min_linear_vel", "min_linear_vel", "min"),
+    ("max_angular_vel", "max_angular_vel", "max"),
+    ("min_angular_vel", "max_angular_vel", "neg"),
+    ("max_linear_accel", "max_linear_acc", "max"),
+    ("max_linear_decel", "max_linear_decel", "max"),
+    ("max_angular_accel", "max_angular_acc", "max"),
+    ("max_angular_decel", "max_angular_decel", "max"),
+)
 
 #: States reported with each command.
 NO_PATH = "no_path"
