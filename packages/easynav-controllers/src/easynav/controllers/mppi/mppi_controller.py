@@ -57,6 +57,8 @@ class MPPIController(ControllerMethodBase):
 
     def on_initialize(self) -> None:
         warn_set_caps(MPPI_LIMIT_CAPS, self.params, self.plugin_name, self.logger.warning)
+        if self.optimizer is not None:  # reconfiguration: stop the previous noise worker
+            self.optimizer.close()
         try:
             self.optimizer = MppiOptimizer(self.params)
         except ValueError as exc:
@@ -69,6 +71,10 @@ class MPPIController(ControllerMethodBase):
         self.state = NO_PATH
         self._last_time = None
         self._path = None
+
+    def on_cleanup(self) -> None:
+        if self.optimizer is not None:
+            self.optimizer.close()
 
     def on_parameter_changed(self, name: str, value: Any) -> None:
         if name == "critics" and self.optimizer is not None:

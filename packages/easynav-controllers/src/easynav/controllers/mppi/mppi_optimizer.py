@@ -16,6 +16,7 @@ import numpy as np
 from easynav.controllers.mppi.critic import Critic
 from easynav.controllers.mppi.critics import CRITICS, DEFAULT_CRITICS
 from easynav.controllers.mppi.mppi_batch import MppiBatch
+from easynav.controllers.mppi.noise_generator import NoiseGenerator
 from easynav.controllers.mppi.rollout import constrain_and_integrate
 from easynav.controllers.mppi.savitzky_golay import smooth_sequence
 from easynav.controllers.regulated_pp.path_geometry import project_on_path
@@ -122,9 +123,8 @@ class MppiOptimizer:
 
     def __init__(self, params: Mapping[str, Any]) -> None:
         self.params = params
-        seed = params["seed"]
-        self.rng = np.random.default_rng(None if seed < 0 else seed)
         self.critics: list[Critic] = []
+        self.noise: NoiseGenerator | None = None
         self.configure_critics()
         self.reset()
 
@@ -137,9 +137,20 @@ class MppiOptimizer:
             critics.append(CRITICS[name](self.params))
         self.critics = critics
 
+    def close(self) -> None:
+        """Stop the noise worker thread (cleanup)."""
+        if self.noise is not None:
+            self.noise.close()
+            self.noise = None
+
     def reset(self) -> None:
         """Forget the warm start, the command history, the path progress and the goal latch."""
         steps = self.params["horizon_steps"]
+        if self.noise is None or self.noise.shape != (2, self.params["num_samples"], steps):
+            self.close()
+            seed = self.params["seed"]
+            self.noise = NoiseGenerator(self.params["num_samples"], steps,
+                                        None if seed < 0 else seed)
         self.sequence = np.zeros((steps, 2), dtype=np.float32)
         self.history = np.zeros((0, 2), dtype=np.float32)
         self.last = (0.0, 0.0)
@@ -233,19 +244,13 @@ class MppiOptimizer:
         # would leave almost no spread to choose from. The optimal sequence and the command
         # are held within the accelerations from the current command below.
         sample_bounds = bounds[:3] + (math.inf,) * 4
-        samples = p["num_samples"]
         std = np.array((p["vx_std"], p["wz_std"]), dtype=np.float32)
         batch = None
         for _ in range(p["iteration_count"]):
-            noise = self.rng.standard_normal((2, samples, steps), dtype=np.float32)
-            ratio = p["constant_noise_ratio"]
-            if ratio > 0.0:
-                # White noise per step averages out over the horizon (a 56-step sample ends
-                # within a few centimetres of the mean); a per-sample constant part samples
-                # arcs that can look round an obstacle, with the same variance per step.
-                constant = self.rng.standard_normal((2, samples, 1), dtype=np.float32)
-                noise *= np.float32(math.sqrt(1.0 - ratio))
-                noise += np.float32(math.sqrt(ratio)) * constant
+            # White noise per step averages out over the horizon (a 56-step sample ends within
+            # a few centimetres of the mean); the constant part samples arcs that can look
+            # round an obstacle, with the same variance per step.
+            noise = self.noise.take(p["constant_noise_ratio"])
             vx = noise[0]
             vx *= std[0]
             vx += self.sequence[:, 0]
@@ -254,7 +259,7 @@ class MppiOptimizer:
             wz += self.sequence[:, 1]
             x, y, yaw = constrain_and_integrate(vx, wz, pose, self.last, dt, sample_bounds)
             batch = MppiBatch(
-                vx, wz, x, y, yaw, np.zeros(samples, dtype=np.float32), dt, pose, self.last,
+                vx, wz, x, y, yaw, np.zeros(len(vx), dtype=np.float32), dt, pose, self.last,
                 limits, path_xy, path_yaw, path_s, is_final, goal, goal_dist, costmap,
             )
             for critic in self.critics:

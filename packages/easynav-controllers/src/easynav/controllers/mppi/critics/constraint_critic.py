@@ -21,7 +21,11 @@ class ConstraintCritic(Critic):
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:
         limits = batch.limits
+        min_v = min(limits.min_linear_vel, 0.0)
+        if (batch.vx.max() <= limits.max_linear_vel and batch.vx.min() >= min_v
+                and np.abs(batch.wz).max() <= limits.max_angular_vel):
+            return None  # the usual case: the optimiser clamped the samples already
         over = np.maximum(batch.vx - limits.max_linear_vel, 0.0)
-        over += np.maximum(min(limits.min_linear_vel, 0.0) - batch.vx, 0.0)
+        over += np.maximum(min_v - batch.vx, 0.0)
         over += np.maximum(np.abs(batch.wz) - limits.max_angular_vel, 0.0)
         return over.sum(axis=1) * batch.dt
