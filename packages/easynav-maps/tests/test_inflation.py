@@ -79,3 +79,33 @@ def test_matches_brute_force_on_random_maps(seed):
 def test_no_lethal_cells_leave_the_map_unchanged():
     data = np.array([[0, 10, 255]], dtype=np.uint8)
     assert inflate(data, 0.05, 0.3, 0.2, 3.0).tolist() == data.tolist()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_compiled_and_opencv_paths_agree(seed):
+    from easynav.maps import inflation
+
+    if not inflation.compiled():
+        pytest.skip("numba not installed: only the OpenCV path exists")
+    rng = np.random.default_rng(100 + seed)
+    shape = (int(rng.integers(1, 120)), int(rng.integers(1, 120)))
+    data = np.zeros(shape, dtype=np.uint8)
+    density = float(rng.choice([0.0, 0.002, 0.02, 0.3, 0.7]))
+    data[rng.random(shape) < density] = 254
+    data[rng.random(shape) < 0.05] = 255
+    cap = int(rng.integers(1, 30))
+    table = inflation.inflation_cost_table(cap, 0.05, 0.1, 3.0)
+    compiled = inflation.inflation_costs(data, cap, table)
+    assert np.array_equal(compiled, inflation.inflation_costs_opencv(data, cap, table))
+    combined = inflation.inflate(data, 0.05, cap * 0.05, 0.1, 3.0)
+    assert np.array_equal(combined, inflation.combine_costs(data, compiled))
+
+
+def test_walls_rows_use_the_envelope_and_match_brute_force():
+    # Long free runs (large column distances) take the lower-envelope branch.
+    data = np.zeros((40, 60), dtype=np.uint8)
+    data[0, :] = 254
+    data[:, 30] = 254
+    data[25, 5] = 254
+    expected = inflate_reference(data, 0.05, 1.0, 0.2, 2.0)
+    assert np.array_equal(inflate(data, 0.05, 1.0, 0.2, 2.0), expected)

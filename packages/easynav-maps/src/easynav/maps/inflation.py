@@ -1,10 +1,9 @@
 """Inflation of a costmap: the original's (Nav2's) cost formula on an exact Euclidean distance.
 
 The original propagates a 4-neighbour wavefront in distance bins and measures each cell's
-Euclidean distance to the seed that reached it. Here the distance of every cell to its nearest
-lethal cell comes from OpenCV's exact Euclidean distance transform (``cv2.distanceTransform``
-with ``DIST_MASK_PRECISE``), and the cost is looked up from the squared distance (an integer), so
-the costs are those of the formula at the true nearest-obstacle distance:
+Euclidean distance to the seed that reached it. Here every cell's exact Euclidean distance to
+its nearest lethal cell is computed, and the cost is looked up from the squared distance (an
+integer), so the costs are those of the formula at the true nearest-obstacle distance:
 
 - ``d = 0`` (a lethal cell) → 254;
 - ``d · resolution <= inscribed_radius`` → 253 (INSCRIBED_INFLATED_OBSTACLE);
@@ -16,6 +15,17 @@ A cell takes ``max(old, inflated)``, except an unknown cell (255), which is over
 
 :func:`inflate_reference` computes the same thing by brute force (the distance to every lethal
 cell), for tests. Pure functions on numpy arrays, any thread; the inputs are never modified.
+
+Two implementations of the distance transform give identical results (tested):
+
+- with numba (``pip install easynav-maps[numba]``): a compiled two-pass exact transform that
+  knows the radius (column distances capped at radius + 1 cell, then per row either a search
+  bounded by the best distance so far or Felzenszwalb's lower envelope of parabolas, skipping
+  cells already beyond the radius), fused with the table look-up and the combination with the
+  old costs: one pass over the output. 2-5× faster than the OpenCV path on one core
+  (benchmarks/bench_inflation.py);
+- without: OpenCV's exact transform (``cv2.distanceTransform``, ``DIST_MASK_PRECISE``) and
+  numpy for the look-up.
 """
 
 from __future__ import annotations
@@ -75,6 +85,14 @@ def distance_to_lethal(data: np.ndarray) -> np.ndarray:
 def inflation_costs(data: np.ndarray, cell_radius: int, table: np.ndarray) -> np.ndarray:
     """The inflated cost of every cell of ``data`` (uint8; 0 beyond the radius), before it is
     combined with the cell's own cost (see :func:`combine_costs`)."""
+    if _compiled_inflate is not None and data.size:
+        cells = np.ascontiguousarray(data, dtype=np.uint8)
+        return _compiled_inflate(cells, cell_radius, table, False)
+    return inflation_costs_opencv(data, cell_radius, table)
+
+
+def inflation_costs_opencv(data: np.ndarray, cell_radius: int, table: np.ndarray) -> np.ndarray:
+    """:func:`inflation_costs` on OpenCV's distance transform (the path without numba)."""
     distance = distance_to_lethal(data)
     np.minimum(distance, float(cell_radius + 1), out=distance)  # beyond: all the same (0)
     squared = np.multiply(distance, distance, out=distance)
@@ -104,6 +122,9 @@ def inflate(
     if cell_radius == 0:
         return np.array(data, dtype=np.uint8, copy=True)
     table = inflation_cost_table(cell_radius, resolution, inscribed_radius, cost_scaling_factor)
+    if _compiled_inflate is not None and np.size(data):
+        cells = np.ascontiguousarray(data, dtype=np.uint8)
+        return _compiled_inflate(cells, cell_radius, table, True)
     return combine_costs(data, inflation_costs(data, cell_radius, table))
 
 
@@ -134,3 +155,134 @@ def inflate_reference(
             else:
                 out[iy, ix] = max(old, cost)
     return out
+
+
+# -- the compiled path ----------------------------------------------------------------------------
+# Squared distances are integers; the column pass caps distances at cap + 1 cells, which keeps
+# every squared distance <= cap² exact and every larger one larger (all that the table needs).
+
+
+def _column_distances(data, cap):  # pragma: no cover - compiled
+    h, w = data.shape
+    big = cap + 1
+    g = np.empty((h, w), np.int64)
+    for x in range(w):
+        g[0, x] = 0 if data[0, x] == 254 else big
+    for y in range(1, h):  # row by row: memory order
+        for x in range(w):
+            if data[y, x] == 254:
+                g[y, x] = 0
+            else:
+                v = g[y - 1, x] + 1
+                g[y, x] = v if v < big else big
+    for y in range(h - 2, -1, -1):
+        for x in range(w):
+            v = g[y + 1, x] + 1
+            if v < g[y, x]:
+                g[y, x] = v
+    return g
+
+
+def _row_bounded_search(row, sq, w):  # pragma: no cover - compiled
+    # Cheap where obstacles are dense: stop once dx² alone exceeds the best distance.
+    for x in range(w):
+        gx = row[x]
+        best = gx * gx
+        dx = 1
+        while dx * dx < best:
+            if x - dx >= 0:
+                c = dx * dx + row[x - dx] * row[x - dx]
+                if c < best:
+                    best = c
+            if x + dx < w:
+                c = dx * dx + row[x + dx] * row[x + dx]
+                if c < best:
+                    best = c
+            dx += 1
+        sq[x] = best
+
+
+def _row_envelope(row, sq, w, cap, v, z):  # pragma: no cover - compiled
+    # Felzenszwalb & Huttenlocher's lower envelope; columns already beyond the radius add no
+    # parabola (they cannot give a distance within it).
+    k = -1
+    for q in range(w):
+        gq = row[q]
+        if gq > cap:
+            continue
+        fq = gq * gq + q * q
+        if k < 0:
+            k = 0
+            v[0] = q
+            z[0] = -1e300
+            z[1] = 1e300
+            continue
+        p = v[k]
+        s = (fq - (row[p] * row[p] + p * p)) / (2.0 * (q - p))
+        while s <= z[k]:
+            k -= 1
+            p = v[k]
+            s = (fq - (row[p] * row[p] + p * p)) / (2.0 * (q - p))
+        k += 1
+        v[k] = q
+        z[k] = s
+        z[k + 1] = 1e300
+    if k < 0:
+        beyond = (cap + 1) * (cap + 1)
+        for q in range(w):
+            sq[q] = beyond
+        return
+    k = 0
+    for q in range(w):
+        while z[k + 1] < q:
+            k += 1
+        p = v[k]
+        sq[q] = (q - p) * (q - p) + row[p] * row[p]
+
+
+def _inflate_kernel(data, cap, table, combine):  # pragma: no cover - compiled
+    h, w = data.shape
+    g = _column_distances(data, cap)
+    out = np.empty((h, w), np.uint8)
+    sq = np.empty(w, np.int64)
+    v = np.empty(w, np.int64)
+    z = np.empty(w + 1, np.float64)
+    limit = cap * cap
+    for y in range(h):
+        row = g[y]
+        total = 0
+        for x in range(w):
+            total += row[x]
+        if total <= 10 * w:  # mean column distance small: the bounded search is cheaper
+            _row_bounded_search(row, sq, w)
+        else:
+            _row_envelope(row, sq, w, cap, v, z)
+        for x in range(w):
+            s = sq[x]
+            c = table[s] if s <= limit else 0
+            if not combine:
+                out[y, x] = c
+                continue
+            old = data[y, x]
+            if old == 255:
+                out[y, x] = c if c >= 253 else old
+            else:
+                out[y, x] = c if c > old else old
+    return out
+
+
+try:
+    import numba
+except ImportError:  # the optional extra is missing: OpenCV serves
+    _compiled_inflate = None
+else:
+    _jit = numba.njit(cache=True, nogil=True)
+    _column_distances = _jit(_column_distances)
+    _row_bounded_search = _jit(_row_bounded_search)
+    _row_envelope = _jit(_row_envelope)
+    _compiled_inflate = _jit(_inflate_kernel)
+
+
+def compiled() -> bool:
+    """Whether the numba-compiled inflation is in use."""
+    return _compiled_inflate is not None

@@ -103,7 +103,7 @@ try:
 except ImportError:  # the optional extra is missing: the reference loop serves
     _compiled = None
 else:
-    _compiled = numba.njit(cache=False, nogil=True)(_clear_along_rays_kernel)
+    _compiled = numba.njit(cache=True, nogil=True)(_clear_along_rays_kernel)
 
 
 def numba_available() -> bool:

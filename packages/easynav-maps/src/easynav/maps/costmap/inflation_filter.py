@@ -16,6 +16,7 @@ from easynav.maps.costmap.keys import MAP_BASE, MAP_OBSTACLE_BOUNDS
 from easynav.maps.inflation import (
     cell_inflation_radius,
     combine_costs,
+    inflate,
     inflation_cost_table,
     inflation_costs,
 )
@@ -79,6 +80,11 @@ class InflationFilter(CostmapFilter):
         self._base_raw = None
         self._inscribed_warning = None
         self.inscribed_radius()  # warn now about a deprecated setting, not at the first cycle
+        # Compile (or load from numba's cache) now, not in the first cycle.
+        warm = np.zeros((3, 3), dtype=np.uint8)
+        warm[1, 1] = 254
+        inflation_costs(warm, 1, inflation_cost_table(1, 1.0, 0.0, 1.0))
+        inflate(warm, 1.0, 1.0, 0.0, 1.0)
 
     def on_parameter_changed(self, name: str, value: Any) -> None:
         self._signature = None  # the cached base inflation used the old value

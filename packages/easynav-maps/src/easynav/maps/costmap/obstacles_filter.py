@@ -66,6 +66,8 @@ class ObstaclesFilter(CostmapFilter):
     def on_initialize(self) -> None:
         self._marks = None
         self._grid = None
+        # Compile the ray caster (or load it from numba's cache) now, not in the first cycle.
+        clear_along_rays(np.zeros((2, 2)), (0, 0), np.array([1]), np.array([1]), 1.0, 2.0)
 
     @property
     def marks(self) -> np.ndarray | None:
