@@ -81,6 +81,7 @@ class CostmapMapsManager(MapsManagerBase):
     )
     READS = (MAP_BASE,)
     WRITES = (MAP_BASE, MAP, MAP_TIME, MAP_OBSTACLE_BOUNDS)
+    PROVIDES_MAPS = ("costmap",)
 
     def __init__(self) -> None:
         super().__init__()
