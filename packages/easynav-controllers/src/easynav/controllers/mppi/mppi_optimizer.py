@@ -201,7 +201,8 @@ class MppiOptimizer:
         if self.sequence.shape[0] != steps:
             self.reset()
         key = path_key if path_key is not None else id(path_xy_yaw)
-        if key != self._path_key:
+        # Identity for path objects (a Path compares its poses field by field); value for ints.
+        if not (key is self._path_key or (type(key) is int and key == self._path_key)):
             self._path_key = key
             self._path = np.asarray(path_xy_yaw, dtype=float)
             lengths = np.hypot(*np.diff(self._path[:, :2], axis=0).T)

@@ -230,7 +230,8 @@ class RegulatedPurePursuit:
             self.reset()
             return RppCommand()
         key = path_key if path_key is not None else id(path_xy_yaw)
-        if key != self._path_key:
+        # Identity for path objects (a Path compares its poses field by field); value for ints.
+        if not (key is self._path_key or (type(key) is int and key == self._path_key)):
             self._set_path(key, path_xy_yaw)
         x, y, yaw = pose
         position = np.array((x, y))
