@@ -12,6 +12,7 @@ from easynav.controllers.mppi.critics import CRITICS, DEFAULT_CRITICS
 from easynav.controllers.mppi.critics.cost_critic import rollout_costs
 from easynav.controllers.mppi.mppi_batch import MppiBatch
 from easynav.controllers.mppi.mppi_controller import MPPIController
+from easynav.controllers.mppi.mppi_optimizer import densify_path
 from easynav.controllers.mppi.rollout import (
     constrain_and_integrate,
     constrain_and_integrate_reference,
@@ -330,3 +331,21 @@ def test_zero_command_when_idle_or_without_path():
     controller.context.now.t += 0.05
     controller.update_rt(nav_state)
     assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero()
+
+
+def test_sparse_paths_are_resampled_for_the_critics():
+    path = np.array([[0.0, 0.0, 0.1], [1.0, 0.0, 0.2], [1.0, 0.12, 0.3]])
+    dense = densify_path(path)
+    steps = np.hypot(*np.diff(dense[:, :2], axis=0).T)
+    assert steps.max() <= 0.05 + 1e-12 and len(dense) == 20 + 3 + 1
+    # Every vertex kept, added points on the segments with the start vertex's yaw.
+    for vertex in path:
+        assert np.any(np.all(np.isclose(dense, vertex), axis=1))
+    assert dense[5] == pytest.approx([0.25, 0.0, 0.1])
+    # A two-vertex plan (a smoothed one) is followed like a dense one.
+    controller = make_controller(NAV2_SIZE)
+    poses, commands, states = run_closed_loop(
+        controller, np.array([[0.0, 0.0, 0.0], [2.5, 0.0, 0.0]]), (0.0, 0.1, 0.0))
+    assert states[-1] == "arrived"
+    assert np.abs(poses[:, 1]).max() < 0.2
+    assert_within_limits(commands)

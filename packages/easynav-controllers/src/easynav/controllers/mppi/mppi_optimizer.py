@@ -95,6 +95,33 @@ PATH_MARGIN = 1.0
 HISTORY = 4
 
 
+#: Spacing (m) the path is resampled to: the critics count path points (``offset_from_furthest``)
+#: as Nav2 does on a costmap-resolution path, while a smoothed plan may have few, far vertices.
+PATH_SPACING = 0.05
+
+
+def densify_path(path_xy_yaw: np.ndarray, spacing: float = PATH_SPACING) -> np.ndarray:
+    """The path with points added so no two consecutive ones are more than ``spacing`` apart.
+
+    Every vertex is kept; points added on a segment take its start vertex's yaw.
+    """
+    path = np.asarray(path_xy_yaw, dtype=float)
+    if len(path) < 2:
+        return path.copy()
+    lengths = np.hypot(*np.diff(path[:, :2], axis=0).T)
+    pieces = np.maximum(np.ceil(lengths / spacing).astype(np.int64), 1)
+    segment = np.repeat(np.arange(len(lengths)), pieces)
+    fraction = (np.arange(pieces.sum()) - np.repeat(np.cumsum(pieces) - pieces, pieces)) / (
+        np.repeat(pieces, pieces)
+    )
+    start, end = path[segment], path[segment + 1]
+    out = np.empty((len(segment) + 1, 3))
+    out[:-1, :2] = start[:, :2] + fraction[:, None] * (end[:, :2] - start[:, :2])
+    out[:-1, 2] = start[:, 2]
+    out[-1] = path[-1]
+    return out
+
+
 @dataclass(slots=True)
 class MppiCommand:
     """One cycle's output: the command, the state and the optimal rollout (T×3, for debugging)."""
@@ -204,7 +231,7 @@ class MppiOptimizer:
         # Identity for path objects (a Path compares its poses field by field); value for ints.
         if not (key is self._path_key or (type(key) is int and key == self._path_key)):
             self._path_key = key
-            self._path = np.asarray(path_xy_yaw, dtype=float)
+            self._path = densify_path(path_xy_yaw)
             lengths = np.hypot(*np.diff(self._path[:, :2], axis=0).T)
             self._s = np.concatenate(([0.0], np.cumsum(lengths)))
             self._segment = -1
