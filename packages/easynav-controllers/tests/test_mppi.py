@@ -349,3 +349,16 @@ def test_sparse_paths_are_resampled_for_the_critics():
     assert states[-1] == "arrived"
     assert np.abs(poses[:, 1]).max() < 0.2
     assert_within_limits(commands)
+
+
+def test_a_section_of_the_original_loads_unchanged():
+    original = {"num_samples": 100, "horizon_steps": 10, "dt": 0.1, "lambda": 0.1,
+                "max_linear_velocity": 1.0, "max_angular_velocity": 1.0,
+                "max_linear_acceleration": 0.5, "max_angular_acceleration": 1.0,
+                "fov": math.pi / 2, "safety_radius": 0.6}
+    controller = make_controller(original, limits=RobotLimits(max_linear_vel=2.0,
+                                                              max_angular_vel=0.5))
+    limits = controller.limits()
+    assert limits.max_linear_vel == 1.0 and limits.max_angular_vel == 0.5
+    assert limits.max_linear_acc == 0.5 and limits.max_linear_decel == 0.5
+    assert controller.optimizer.sequence.shape == (10, 2)

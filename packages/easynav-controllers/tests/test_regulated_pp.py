@@ -338,3 +338,32 @@ def test_bad_parameter_is_named():
         make_controller({"lookahead_dist": -1.0})
     with pytest.raises(PluginConfigurationError, match="rpp.use_dynamic_window"):
         make_controller({"use_dynamic_window": "yes"})
+
+
+def test_a_section_of_the_original_loads_unchanged():
+    # Every parameter of the original's RPP with its default (CATALOGUE §3.1).
+    original = {
+        "lookahead_dist": 0.6, "min_lookahead_dist": 0.3, "max_lookahead_dist": 0.9,
+        "lookahead_time": 1.5, "use_velocity_scaled_lookahead_dist": False,
+        "max_linear_vel": 0.5, "min_linear_vel": -0.5, "max_angular_vel": 2.5,
+        "min_angular_vel": -2.5, "max_linear_accel": 2.5, "max_linear_decel": 2.5,
+        "max_angular_accel": 3.2, "max_angular_decel": 3.2, "use_dynamic_window": False,
+        "allow_reversing": False, "use_rotate_to_heading": True,
+        "rotate_to_heading_angular_vel": 1.8, "rotate_to_heading_min_angle": 0.785,
+        "use_regulated_linear_velocity_scaling": True,
+        "regulated_linear_scaling_min_radius": 0.9, "regulated_linear_scaling_min_speed": 0.25,
+        "use_fixed_curvature_lookahead": False, "curvature_lookahead_dist": 1.0,
+        "interpolate_curvature_after_goal": False,
+        "use_obstacle_regulated_linear_velocity_scaling": False, "obstacle_scaling_dist": 0.3,
+        "obstacle_scaling_gain": 1.0, "min_approach_linear_velocity": 0.05,
+        "approach_velocity_scaling_dist": 1.0, "xy_goal_tolerance": 0.25,
+        "yaw_goal_tolerance": 0.25,
+    }
+    declared = {p.name for p in RegulatedPurePursuitController.parameter_declarations()}
+    assert set(original) <= declared
+    controller = make_controller(original, limits=RobotLimits(max_linear_vel=1.0,
+                                                              max_angular_vel=3.0))
+    # The original's limits cap the limits in force (never raise them).
+    limits = controller.limits()
+    assert limits.max_linear_vel == 0.5 and limits.max_angular_vel == 2.5
+    assert limits.min_linear_vel == RobotLimits().min_linear_vel  # -0.2 is tighter than -0.5
