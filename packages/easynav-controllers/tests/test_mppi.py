@@ -362,3 +362,22 @@ def test_a_section_of_the_original_loads_unchanged():
     assert limits.max_linear_vel == 1.0 and limits.max_angular_vel == 0.5
     assert limits.max_linear_acc == 0.5 and limits.max_linear_decel == 0.5
     assert controller.optimizer.sequence.shape == (10, 2)
+
+
+def test_forward_only_robot_arrives_at_a_goal_facing_across_the_path():
+    # The playground's limits (no reversing) and a goal yaw at 90° to the approach, as the
+    # tb3_sandbox tour's first waypoint: the robot drives up, then turns in place.
+    limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0)
+    controller = make_controller(NAV2_SIZE, limits=limits)
+    path = straight_path(1.5)
+    path[:, 2] = math.pi / 2
+    nav_state = NavState()
+    nav_state.set("goal_tolerance.position", 0.15)
+    nav_state.set("goal_tolerance.yaw", 0.15)
+    poses, commands, states = run_closed_loop(controller, path, (0.0, 0.0, 0.0), steps=600,
+                                              nav_state=nav_state)
+    assert states[-1] == "arrived"
+    assert math.hypot(poses[-1][0] - 1.5, poses[-1][1]) <= 0.15
+    assert abs(normalize_angle(poses[-1][2] - math.pi / 2)) <= 0.15
+    assert commands[:, 0].min() >= 0.0
+    assert_within_limits(commands, limits)

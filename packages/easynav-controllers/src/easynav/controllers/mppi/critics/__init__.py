@@ -26,12 +26,15 @@ CRITICS = {
     )
 }
 
-#: The default ``critics`` list (Nav2's default set: TwirlingCritic is available, not default).
+#: The default ``critics`` list: Nav2's default set without GoalAngleCritic. The controller
+#: turns in place to the goal yaw once within the xy tolerance; GoalAngleCritic would turn a
+#: forward-only robot to that yaw before it arrives, and it then circles round the goal
+#: (reproduced between the tb3_sandbox pillars). GoalAngleCritic and TwirlingCritic are
+#: available.
 DEFAULT_CRITICS = [
     "ConstraintCritic",
     "CostCritic",
     "GoalCritic",
-    "GoalAngleCritic",
     "PathAlignCritic",
     "PathFollowCritic",
     "PathAngleCritic",
