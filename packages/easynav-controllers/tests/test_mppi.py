@@ -381,3 +381,20 @@ def test_forward_only_robot_arrives_at_a_goal_facing_across_the_path():
     assert abs(normalize_angle(poses[-1][2] - math.pi / 2)) <= 0.15
     assert commands[:, 0].min() >= 0.0
     assert_within_limits(commands, limits)
+
+
+def test_brakes_when_every_candidate_collides():
+    # A wall right in front of a robot that cannot turn fast: every rollout enters it.
+    costmap = Costmap2D.filled(100, 100, 0.05, -2.5, -2.5)
+    ix, _ = costmap.world_to_cell(0.06, 0.0)  # closer than the braking distance (0.08 m)
+    costmap.data[:, ix:] = LETHAL_OBSTACLE
+    limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=0.1,
+                         max_linear_decel=1.0)
+    controller = make_controller(NAV2_SIZE, limits=limits)
+    optimizer = controller.optimizer
+    optimizer.last = (0.4, 0.0)
+    command = optimizer.compute((0.0, 0.0, 0.0), straight_path(2.0), 0.05, limits, 0.15, 0.15,
+                                costmap, path_key=1)
+    assert command.state == "blocked"
+    assert command.v == pytest.approx(0.4 - 1.0 * 0.05) and command.w == 0.0
+    assert not optimizer.sequence.any()

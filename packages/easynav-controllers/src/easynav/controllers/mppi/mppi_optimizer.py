@@ -15,6 +15,7 @@ import numpy as np
 
 from easynav.controllers.mppi.critic import Critic
 from easynav.controllers.mppi.critics import CRITICS, DEFAULT_CRITICS
+from easynav.controllers.mppi.critics.cost_critic import rollout_costs
 from easynav.controllers.mppi.mppi_batch import MppiBatch
 from easynav.controllers.mppi.noise_generator import NoiseGenerator
 from easynav.controllers.mppi.rollout import constrain_and_integrate
@@ -23,7 +24,12 @@ from easynav.controllers.regulated_pp.path_geometry import project_on_path
 from easynav.controllers.regulated_pp.regulation import rotation_speed
 from easynav.core.plugins import Param
 from easynav.core.robot import RobotLimits
-from easynav.core.types import Costmap2D, normalize_angle
+from easynav.core.types import (
+    INSCRIBED_INFLATED_OBSTACLE,
+    NO_INFORMATION,
+    Costmap2D,
+    normalize_angle,
+)
 
 NAN = math.nan
 
@@ -86,6 +92,10 @@ MPPI_LIMIT_CAPS = (
 #: States reported with each command.
 NO_PATH = "no_path"
 FOLLOWING = "following"
+#: The weighted mean collided: the best sample was applied instead.
+FALLBACK = "fallback"
+#: Every candidate collided: braking.
+BLOCKED = "blocked"
 ROTATING_TO_GOAL = "rotating_to_goal"
 ARRIVED = "arrived"
 
@@ -140,7 +150,9 @@ class MppiOptimizer:
     limits in force (speeds, and accelerations from the current command), the rollouts are
     integrated as a unicycle, the critics add their costs (plus Nav2's control cost ``gamma``),
     and the new sequence is the softmin-weighted mean (temperature ``lambda``), Savitzky–Golay
-    smoothed with the last applied commands and constrained again. Its first command is applied.
+    smoothed with the last applied commands and constrained again. Its first command is applied,
+    unless its rollout enters an inscribed or lethal cell: then the best sample's (state
+    ``fallback``), and when that collides too the robot brakes (state ``blocked``).
     Inside the goal's xy tolerance it rotates in place to the goal yaw and stops within the yaw
     tolerance.
 
@@ -308,11 +320,37 @@ class MppiOptimizer:
         v_seq = self.sequence[None, :, 0].copy()
         w_seq = self.sequence[None, :, 1].copy()
         ox, oy, oyaw = constrain_and_integrate(v_seq, w_seq, pose, self.last, dt, bounds)
+        state = FOLLOWING
+        if costmap is not None and self._collides(costmap, ox[0], oy[0]):
+            # The weighted mean of collision-free samples (two ways round an obstacle) may
+            # itself collide: fall back to the best sample, held within the accelerations.
+            best = int(np.argmin(batch.costs))
+            v_seq = batch.vx[best][None].copy()
+            w_seq = batch.wz[best][None].copy()
+            ox, oy, oyaw = constrain_and_integrate(v_seq, w_seq, pose, self.last, dt, bounds)
+            if self._collides(costmap, ox[0], oy[0]):
+                # Nothing safe in reach: brake and start the next optimisation afresh.
+                self.sequence[:] = 0.0
+                self.last_batch = batch
+                v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
+                    self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
+                                                 * elapsed)
+                return self._apply(v, 0.0, BLOCKED)
+            state = FALLBACK
         self.sequence[:, 0] = v_seq[0]
         self.sequence[:, 1] = w_seq[0]
         self.last_batch = batch
         optimal = np.column_stack((ox[0], oy[0], oyaw[0]))
-        return self._apply(float(v_seq[0, 0]), float(w_seq[0, 0]), FOLLOWING, optimal)
+        return self._apply(float(v_seq[0, 0]), float(w_seq[0, 0]), state, optimal)
+
+    def _collides(self, costmap: Costmap2D, x: np.ndarray, y: np.ndarray) -> bool:
+        """Whether a rollout enters an inscribed or lethal cell (or unknown space, as the
+        CostCritic's ``consider_unknown_lethal`` says)."""
+        costs = rollout_costs(costmap, x, y)
+        lethal = costs >= INSCRIBED_INFLATED_OBSTACLE
+        if not self.params["CostCritic.consider_unknown_lethal"]:
+            lethal &= costs != NO_INFORMATION
+        return bool(lethal.any())
 
     def _apply(self, v: float, w: float, state: str, optimal=None) -> MppiCommand:
         self.last = (v, w)
