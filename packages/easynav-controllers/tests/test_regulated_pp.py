@@ -367,3 +367,32 @@ def test_a_section_of_the_original_loads_unchanged():
     limits = controller.limits()
     assert limits.max_linear_vel == 0.5 and limits.max_angular_vel == 2.5
     assert limits.min_linear_vel == RobotLimits().min_linear_vel  # -0.2 is tighter than -0.5
+
+
+def test_a_rotation_toward_a_target_behind_keeps_its_direction():
+    from easynav.controllers.regulated_pp.regulation import latched_angle
+
+    assert latched_angle(-3.1, 1.0) == pytest.approx(3.1)  # noise flipped it: keep turning left
+    assert latched_angle(-1.0, 1.0) == -1.0  # not ambiguous: the real sign
+    assert latched_angle(-3.1, 0.0) == -3.1
+    # Closed loop: the path starts straight behind the robot, the pose estimate jitters across
+    # ±π; the robot turns round one way and follows the path.
+    controller = make_controller()
+    path = straight_path(2.0)
+    path[:, 0] *= -1.0
+    path[:, 2] = math.pi
+    jitter = itertools.cycle((0.03, -0.03))
+    nav_state = NavState()
+    nav_state.set("path", Path.from_xy_yaw(path))
+    x, y, yaw = 0.0, 0.0, 0.0
+    for _ in range(600):
+        set_pose(nav_state, x, y, normalize_angle(yaw + next(jitter)))
+        controller.update_rt(nav_state)
+        cmd = nav_state.get("cmd_vel", TwistStamped).twist
+        if controller.state == ARRIVED:
+            break
+        x += cmd.vx * math.cos(yaw) * 0.05
+        y += cmd.vx * math.sin(yaw) * 0.05
+        yaw = normalize_angle(yaw + cmd.wz * 0.05)
+        controller.context.now.t += 0.05
+    assert controller.state == ARRIVED and x < -1.7

@@ -21,7 +21,7 @@ from easynav.controllers.mppi.noise_generator import NoiseGenerator
 from easynav.controllers.mppi.rollout import constrain_and_integrate
 from easynav.controllers.mppi.savitzky_golay import smooth_sequence
 from easynav.controllers.regulated_pp.path_geometry import project_on_path
-from easynav.controllers.regulated_pp.regulation import rotation_speed
+from easynav.controllers.regulated_pp.regulation import latched_angle, rotation_speed
 from easynav.core.plugins import Param
 from easynav.core.robot import RobotLimits
 from easynav.core.types import (
@@ -67,6 +67,15 @@ MPPI_OWN_PARAMETERS = (
           dynamic=False),
     Param("critics", list(DEFAULT_CRITICS), "the critics that score the batch, in order",
           type="str[]", choices=tuple(CRITICS)),
+    Param("use_rotate_to_heading", True,
+          "rotate in place first when the path ahead is far off the heading (Nav2's rotation "
+          "shim): sampled turns left and right cancel out when the path is behind"),
+    Param("rotate_to_heading_min_angle", 1.57,
+          "angle to the path ahead that starts a rotation in place (stops below half of it; "
+          "smaller ones are left to the critics, which steer round obstacles)",
+          "rad", gt=0.0),
+    Param("rotate_to_heading_lookahead_dist", 0.5, "distance along the path of that point", "m",
+          gt=0.0),
     Param("xy_goal_tolerance", 0.25, "used only when NavState has no goal_tolerance.position",
           "m", gt=0.0),
     Param("yaw_goal_tolerance", 0.25, "used only when NavState has no goal_tolerance.yaw", "rad",
@@ -97,6 +106,7 @@ FALLBACK = "fallback"
 #: Every candidate collided: braking.
 BLOCKED = "blocked"
 ROTATING_TO_GOAL = "rotating_to_goal"
+ROTATING_TO_HEADING = "rotating_to_heading"
 ARRIVED = "arrived"
 
 #: Arc length (m) of the path kept ahead of the rollouts' reach.
@@ -198,6 +208,8 @@ class MppiOptimizer:
         self._s = np.zeros(0)
         self._segment = 0
         self._at_goal_xy = False
+        self._rotating = False
+        self._rotation_sign = 0.0
         self.last_batch: MppiBatch | None = None
 
     # -- path ----------------------------------------------------------------------------------
@@ -256,9 +268,10 @@ class MppiOptimizer:
         goal_dist = math.hypot(goal[0] - x0, goal[1] - y0)
         if goal_dist <= xy_tolerance or (self._at_goal_xy and goal_dist <= 2.0 * xy_tolerance):
             self._at_goal_xy = True
-            error = normalize_angle(goal[2] - yaw0)
+            error = self._latch(normalize_angle(goal[2] - yaw0))
             self.sequence[:] = 0.0
             if abs(error) <= yaw_tolerance:
+                self._rotation_sign = 0.0
                 return self._apply(0.0, 0.0, ARRIVED)
             w = rotation_speed(error, self.last[1], elapsed, max_w, limits.max_angular_acc,
                                limits.max_angular_decel, max_w)
@@ -267,6 +280,21 @@ class MppiOptimizer:
 
         reach = max(max_v, abs(limits.min_linear_vel)) * steps * dt + PATH_MARGIN
         path_xy, path_yaw, path_s, is_final = self._local_path(np.array((x0, y0)), reach)
+        if p["use_rotate_to_heading"]:
+            ahead = min(int(np.searchsorted(path_s, p["rotate_to_heading_lookahead_dist"])),
+                        len(path_xy) - 1)
+            tx, ty = path_xy[ahead]
+            angle = normalize_angle(math.atan2(ty - y0, tx - x0) - yaw0)
+            threshold = p["rotate_to_heading_min_angle"] * (0.5 if self._rotating else 1.0)
+            if math.hypot(tx - x0, ty - y0) > 1e-3 and abs(angle) > threshold:
+                self._rotating = True
+                angle = self._latch(angle)
+                self.sequence[:] = 0.0
+                w = rotation_speed(angle, self.last[1], elapsed, max_w, limits.max_angular_acc,
+                                   limits.max_angular_decel, max_w)
+                return self._apply(0.0, w, ROTATING_TO_HEADING)
+        self._rotating = False
+        self._rotation_sign = 0.0
 
         # Warm start: the previous optimal sequence, shifted by the time elapsed.
         shift = min(max(int(round(elapsed / dt)), 0), steps)
@@ -351,6 +379,12 @@ class MppiOptimizer:
         if not self.params["CostCritic.consider_unknown_lethal"]:
             lethal &= costs != NO_INFORMATION
         return bool(lethal.any())
+
+    def _latch(self, angle: float) -> float:
+        # Keep turning the way a rotation in place started while the target is near ±π.
+        angle = latched_angle(angle, self._rotation_sign)
+        self._rotation_sign = 1.0 if angle >= 0.0 else -1.0
+        return angle
 
     def _apply(self, v: float, w: float, state: str, optimal=None) -> MppiCommand:
         self.last = (v, w)

@@ -23,6 +23,7 @@ from easynav.controllers.regulated_pp.regulation import (
     approach_limited_speed,
     corridor_clearance,
     curvature_limited_speed,
+    latched_angle,
     obstacle_limited_speed,
     rotation_speed,
     scaled_lookahead,
@@ -157,6 +158,7 @@ class RegulatedPurePursuit:
         self._segment = 0
         self._last = (0.0, 0.0)
         self._rotating = False
+        self._rotation_sign = 0.0
         self._at_goal_xy = False
 
     @property
@@ -252,8 +254,9 @@ class RegulatedPurePursuit:
         if final_part and (goal_dist <= xy_tolerance or
                            (self._at_goal_xy and goal_dist <= 2.0 * xy_tolerance)):
             self._at_goal_xy = True
-            error = normalize_angle(float(goal[2]) - yaw)
+            error = self._latch(normalize_angle(float(goal[2]) - yaw))
             if abs(error) <= yaw_tolerance:
+                self._rotation_sign = 0.0
                 return self._out(0.0, 0.0, ARRIVED)
             w = rotation_speed(error, self._last[1], dt, p["rotate_to_heading_angular_vel"],
                                limits.max_angular_acc, limits.max_angular_decel, max_w)
@@ -273,10 +276,12 @@ class RegulatedPurePursuit:
         threshold = p["rotate_to_heading_min_angle"] * (0.5 if self._rotating else 1.0)
         if p["use_rotate_to_heading"] and abs(heading) > threshold:
             self._rotating = True
+            heading = self._latch(heading)
             w = rotation_speed(heading, self._last[1], dt, p["rotate_to_heading_angular_vel"],
                                limits.max_angular_acc, limits.max_angular_decel, max_w)
             return self._out(0.0, w, ROTATING_TO_HEADING, carrot)
         self._rotating = False
+        self._rotation_sign = 0.0
 
         curvature_carrot = carrot
         regulation_curvature = curvature
@@ -339,6 +344,12 @@ class RegulatedPurePursuit:
             if curvature != 0.0 and not p["use_dynamic_window"]:
                 v = w / curvature
         return self._out(v, w, FOLLOWING, carrot, curvature_carrot, regulations)
+
+    def _latch(self, angle: float) -> float:
+        # Keep turning the way a rotation in place started while the target is near ±π.
+        angle = latched_angle(angle, self._rotation_sign)
+        self._rotation_sign = 1.0 if angle >= 0.0 else -1.0
+        return angle
 
     def _out(self, v, w, state, carrot=None, curvature_carrot=None, regulations=None):
         self._last = (float(v), float(w))

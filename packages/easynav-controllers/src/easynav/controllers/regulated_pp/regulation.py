@@ -85,6 +85,18 @@ def rotation_speed(
     return min(max(sign * speed, low), high)
 
 
+def latched_angle(angle: float, latched_sign: float, ambiguous: float = 2.5) -> float:
+    """``angle`` turned the latched way while it is near ±π (``|angle| > ambiguous``).
+
+    A target almost behind flips between +π and −π with every bit of estimate noise; without
+    the latch a rotation in place would change direction each cycle and never turn. A
+    ``latched_sign`` of 0 latches nothing.
+    """
+    if latched_sign == 0.0 or abs(angle) <= ambiguous:
+        return angle
+    return math.copysign(abs(angle), latched_sign)
+
+
 def corridor_clearance(
     costmap: Costmap2D,
     pose: tuple[float, float, float],
