@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
+from typing import Any
 
 from geometry_msgs.msg import Twist as TwistMsg
 from geometry_msgs.msg import TwistStamped as TwistStampedMsg
@@ -19,6 +20,7 @@ from rclpy.qos import (
 
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
+from easynav.core.plugins.declarations import Param, ParameterValueError
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
 from easynav.core.ros.converters import header_to_msg, twist_to_msg
@@ -26,7 +28,8 @@ from easynav.core.system.component_node import ComponentNode, ConfigurationError
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
 from easynav.core.velocity import VelocityOutput
 
-# Former per-controller limit parameters and the robot_limits field each one stands for.
+# Former per-controller limit parameters (``<alias>.max_linear_speed``...), declared by the
+# controllers that had them, and the robot_limits field each one stands for.
 DEPRECATED_LIMIT_PARAMETERS = {
     "max_linear_speed": "max_linear_vel",
     "max_angular_speed": "max_angular_vel",
@@ -34,6 +37,36 @@ DEPRECATED_LIMIT_PARAMETERS = {
     "max_angular_acc": "max_angular_acc",
 }
 
+_LIMIT_DESCRIPTIONS = {
+    "max_linear_vel": ("forward speed limit", "m/s"),
+    "min_linear_vel": ("reverse speed limit (<= 0; 0: never reverse)", "m/s"),
+    "max_angular_vel": ("turn rate limit (either direction)", "rad/s"),
+    "max_linear_acc": ("linear acceleration limit", "m/s²"),
+    "max_linear_decel": ("linear deceleration limit", "m/s²"),
+    "max_angular_acc": ("angular acceleration limit", "rad/s²"),
+    "max_angular_decel": ("angular deceleration limit", "rad/s²"),
+}
+
+
+def _limit_param(name: str, default: float) -> Param:
+    description, unit = _LIMIT_DESCRIPTIONS[name]
+    if name == "min_linear_vel":
+        return Param(f"robot_limits.{name}", default, description, unit, le=0.0)
+    if name.endswith("_vel"):
+        return Param(f"robot_limits.{name}", default, description, unit, ge=0.0)
+    return Param(f"robot_limits.{name}", default, description, unit, gt=0.0)
+
+
+#: controller_node's own parameters.
+CONTROLLER_NODE_PARAMETERS = (
+    *(_limit_param(name, default) for name, default in DEFAULT_ROBOT_LIMITS.items()),
+    Param("cmd_timeout", 0.5, "a controller command older than this brakes to zero (0: off)",
+          "s", ge=0.0, dynamic=False),
+    Param("cmd_vel_keepalive_period", 0.0,
+          "republish the last command at this period, with a QoS deadline (0: off)", "s",
+          ge=0.0, dynamic=False),
+    Param("use_cmd_vel_stamped", False, "publish TwistStamped on cmd_vel_stamped", dynamic=False),
+)
 
 
 class ControllerNode(ComponentNode):
@@ -48,6 +81,7 @@ class ControllerNode(ComponentNode):
     deactivates or shuts down, while the RT loop no longer cycles.
     """
 
+    NODE_PARAMETERS = CONTROLLER_NODE_PARAMETERS
     KIND = CONTROLLER
     TYPES_PARAMETER = "controller_types"
     MAX_PLUGINS = 1
@@ -67,29 +101,38 @@ class ControllerNode(ComponentNode):
 
     # -- configuration --------------------------------------------------------------------------
     def configure_node(self) -> None:
-        node = self.get_name()
-        values = {
-            name: float(self.params.declare(f"robot_limits.{name}", default))
-            for name, default in DEFAULT_ROBOT_LIMITS.items()
-        }
-        self.robot_limits = RobotLimits(**values)
-        self.cmd_timeout = float(self.params.declare("cmd_timeout", 0.5))
-        self.keepalive_period = float(self.params.declare("cmd_vel_keepalive_period", 0.0))
-        stamped = bool(self.params.declare("use_cmd_vel_stamped", False))
-        if self.forced_use_stamped is not None and "use_cmd_vel_stamped" not in (
-            self._parameter_overrides
-        ):
+        values = self.read_node_parameters()
+        self.robot_limits = RobotLimits(
+            **{name: values[f"robot_limits.{name}"] for name in DEFAULT_ROBOT_LIMITS}
+        )
+        self.cmd_timeout = values.cmd_timeout
+        self.keepalive_period = values.cmd_vel_keepalive_period
+        stamped = values.use_cmd_vel_stamped
+        if self.forced_use_stamped is not None and not self.params.is_set("use_cmd_vel_stamped"):
             stamped = self.forced_use_stamped
         self.use_stamped = stamped
-        errors = self.robot_limits.validation_errors(f"{node}.robot_limits.")
-        for name, value in (
-            ("cmd_timeout", self.cmd_timeout),
-            ("cmd_vel_keepalive_period", self.keepalive_period),
-        ):
-            if not (value >= 0.0 and value != float("inf")):
-                errors.append(f"{node}.{name} = {value} must be finite and >= 0")
+        self._check_limits()
+
+    def _check_limits(self) -> None:
+        errors = self.robot_limits.validation_errors(f"{self.get_name()}.robot_limits.")
         if errors:
             raise ConfigurationError("; ".join(errors))
+
+    def check_node_parameter(self, name: str, value: Any) -> None:
+        if name.startswith("robot_limits."):
+            field = name.removeprefix("robot_limits.")
+            errors = replace(self.robot_limits, **{field: value}).validation_errors(
+                f"{self.get_name()}.robot_limits."
+            )
+            if errors:
+                raise ParameterValueError("; ".join(errors))
+
+    def on_node_parameter_changed(self, name: str, value: Any) -> None:
+        """A runtime change of ``robot_limits.*`` is in force from the next RT cycle."""
+        if name.startswith("robot_limits."):
+            self.robot_limits = replace(
+                self.robot_limits, **{name.removeprefix("robot_limits."): float(value)}
+            )
 
     def after_plugins_loaded(self) -> None:
         self._apply_deprecated_limits()
@@ -111,19 +154,34 @@ class ControllerNode(ComponentNode):
         self._create_publisher()
 
     def _apply_deprecated_limits(self) -> None:
-        overrides = self._parameter_overrides
+        """A controller's deprecated ``<alias>.max_linear_speed``... stands for a robot_limits
+        field only where the user did not set that field (params file, ``ros2 param set``, a
+        recovery mitigation): explicit robot_limits win. Applied, it is written into the
+        robot_limits parameter too, so what is read back (and restored after a mitigation) is
+        the limit in force."""
         for lp in self.plugins:
             for old, new in DEPRECATED_LIMIT_PARAMETERS.items():
                 old_name = f"{lp.alias}.{old}"
-                if old_name in overrides and f"robot_limits.{new}" not in overrides:
-                    value = float(overrides[old_name].value)
+                if not self.params.is_set(old_name) or old not in lp.plugin.params:
+                    continue
+                value = lp.plugin.params[old]
+                field_name = f"robot_limits.{new}"
+                if self.params.is_set(field_name):
                     self.get_logger().warning(
-                        f"{old_name} is deprecated: use robot_limits.{new} (applied: {value})"
+                        f"{old_name} is deprecated and ignored: {field_name} is set"
                     )
-                    self.robot_limits = replace(self.robot_limits, **{new: value})
-        errors = self.robot_limits.validation_errors(f"{self.get_name()}.robot_limits.")
-        if errors:
-            raise ConfigurationError("; ".join(errors))
+                    continue
+                self.get_logger().warning(
+                    f"{old_name} is deprecated: use {field_name} (applied: {value:g})"
+                )
+                self.robot_limits = replace(self.robot_limits, **{new: float(value)})
+                self._write_limit(field_name, float(value))
+        self._check_limits()
+
+    def _write_limit(self, name: str, value: float) -> None:
+        # Not a user's change: the deprecated value must still yield to a later explicit one.
+        self.params.set(name, value)
+        self.params.changed.discard(name)
 
     def _create_publisher(self) -> None:
         if self.cmd_publisher is not None:

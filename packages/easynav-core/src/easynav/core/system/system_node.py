@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import math
 import threading
+from dataclasses import replace
 from typing import Any
 
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
@@ -11,6 +11,8 @@ from rclpy.node import Node
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import String
 
+from easynav.core.goals.goal_manager_params import GOAL_MANAGER_PARAMETERS
+from easynav.core.plugins.declarations import Param, ParameterValueError, read_parameters
 from easynav.core.robot import RobotGeometry, RobotGeometryRegistry
 from easynav.core.system.component_node import ComponentNode
 from easynav.core.system.controller_node import ControllerNode
@@ -27,27 +29,36 @@ from easynav.core.system.system_context import SystemContext
 from easynav.core.system.system_requests import SystemRequests
 from easynav.core.tf import TFInfo, TFListener, get_tf_buffer
 
-#: Parameters of system_node and their defaults (REFERENCE.md §1).
-SYSTEM_DEFAULTS: dict[str, Any] = {
-    "use_real_time": True,
-    "rt_freq": 200.0,
-    "freq": 200.0,
-    "spin_time_rt": 0.001,
-    "spin_time_nort": 0.001,
-    "tf_prefix": "",
-    "map_frame": "map",
-    "odom_frame": "odom",
-    "robot_frame": "base_link",
-    "robot_footprint_frame": "base_footprint",
-    "world_frame": "earth",
-    "robot_geometry.radius": 0.3,
-    "robot_geometry.height": 0.5,
-    "allow_preempt_goal": True,
-    "position_tolerance": 0.03,
-    "height_tolerance": 1.7976931348623157e308,  # the largest finite double
-    "angle_tolerance": 0.01,
-    "update_frequency": 20.0,
-}
+#: system_node's own parameters (REFERENCE.md §1); the goal manager's follow.
+SYSTEM_PARAMETERS: tuple[Param, ...] = (
+    Param("use_real_time", True, "RT loop at SCHED_FIFO priority when allowed", dynamic=False),
+    Param("rt_freq", 200.0, "frequency of the RT cycle", "Hz", gt=0.0, dynamic=False),
+    Param("freq", 200.0, "frequency of the non-RT cycle", "Hz", gt=0.0, dynamic=False),
+    Param("spin_time_rt", 0.001, "time the RT loop spins its executor per cycle", "s", ge=0.0,
+          dynamic=False),
+    Param("spin_time_nort", 0.001, "time the non-RT loop spins its executor per cycle", "s",
+          ge=0.0, dynamic=False),
+    Param("tf_prefix", "", "prefix of every frame name (multi-robot)", dynamic=False),
+    Param("map_frame", "map", "the map frame", dynamic=False),
+    Param("odom_frame", "odom", "the odometry frame", dynamic=False),
+    Param("robot_frame", "base_link", "the robot frame", dynamic=False),
+    Param("robot_footprint_frame", "base_footprint", "the robot's footprint frame",
+          dynamic=False),
+    Param("world_frame", "earth", "the world frame", dynamic=False),
+    Param("robot_geometry.radius", 0.3, "circumscribed radius of the robot", "m", ge=0.0,
+          dynamic=False),
+    Param("robot_geometry.inscribed_radius", 0.3,
+          "largest circle inside the robot (default: robot_geometry.radius)", "m", ge=0.0,
+          dynamic=False),
+    Param("robot_geometry.height", 0.5, "top of the robot above the robot frame", "m", ge=0.0,
+          dynamic=False),
+    *GOAL_MANAGER_PARAMETERS,
+)
+
+SYSTEM_PARAMETERS_BY_NAME = {param.name: param for param in SYSTEM_PARAMETERS}
+
+#: Defaults by name (read-only view for tools and tests).
+SYSTEM_DEFAULTS: dict[str, Any] = {param.name: param.default for param in SYSTEM_PARAMETERS}
 
 # The order in which sub-nodes configure; cleanup runs in reverse.
 SUBNODE_ORDER = (
@@ -150,32 +161,19 @@ class SystemNode(LifecycleNode):
     # -- configuration --------------------------------------------------------------------------
     def read_parameters(self) -> None:
         """Declare and check system_node's own parameters; raises ValueError naming one."""
-        p = {name: self.params.declare(name, default) for name, default in SYSTEM_DEFAULTS.items()}
-        radius = float(p["robot_geometry.radius"])
-        p["robot_geometry.inscribed_radius"] = float(
-            self.params.declare("robot_geometry.inscribed_radius", radius)
-        )
-        errors = []
-        for name in ("rt_freq", "freq", "update_frequency"):
-            value = float(p[name])
-            if not math.isfinite(value) or value <= 0.0:
-                errors.append(f"system_node.{name} = {value} must be finite and > 0")
-        for name in (
-            "spin_time_rt",
-            "spin_time_nort",
-            "robot_geometry.radius",
-            "robot_geometry.inscribed_radius",
-            "robot_geometry.height",
-        ):
-            value = float(p[name])
-            if not math.isfinite(value) or value < 0.0:
-                errors.append(f"system_node.{name} = {value} must be finite and >= 0")
-        for name in ("position_tolerance", "angle_tolerance", "height_tolerance"):
-            value = float(p[name])
-            if not value >= 0.0:
-                errors.append(f"system_node.{name} = {value} must be >= 0")
-        if errors:
-            raise ValueError("; ".join(errors))
+        by_name = SYSTEM_PARAMETERS_BY_NAME
+        try:
+            # inscribed_radius defaults to the radius in force.
+            radius = read_parameters([by_name["robot_geometry.radius"]], self.params, "")
+            inscribed = replace(
+                by_name["robot_geometry.inscribed_radius"],
+                default=radius["robot_geometry.radius"],
+            )
+            declarations = [inscribed if p.name == inscribed.name else p for p in SYSTEM_PARAMETERS]
+            p = dict(read_parameters(declarations, self.params, ""))
+        except ParameterValueError as exc:
+            raise ValueError(f"system_node.{exc}") from None
+        radius = p["robot_geometry.radius"]
         self.parameters = p
         self.system.system_rt_freq = float(p["rt_freq"])
         self.system.system_freq = float(p["freq"])
@@ -202,6 +200,10 @@ class SystemNode(LifecycleNode):
                 radius=radius,
                 inscribed_radius=float(p["robot_geometry.inscribed_radius"]),
                 height=float(p["robot_geometry.height"]),
+                user_set=frozenset(
+                    name for name in ("radius", "inscribed_radius", "height")
+                    if self.params.is_set(f"robot_geometry.{name}")
+                ),
             ),
             self._ns_key(),
         )
