@@ -5,12 +5,14 @@ recovery system driven by diagnostics, made of reflex, evaluator and mitigation 
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from typing import Any
 
 from easynav.core.diagnostics import read_diagnostics, write_diagnostic
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import (
     MethodBase,
+    Param,
     PluginConfigurationError,
     RateMonitor,
     RecoveryManagerBase,
@@ -28,7 +30,6 @@ from easynav.recovery.diagnostic.plugin_kinds import EVALUATOR, MITIGATION, SAFE
 from easynav.recovery.diagnostic.recovery_topics import RecoveryTopics
 from easynav.recovery.diagnostic.safety_reflex_base import SafetyReflexBase
 from easynav.recovery.navigation_context import commanded_velocity
-from easynav.recovery.parameters import read_int, read_str_list
 from easynav.recovery.takeover_slot import TakeoverSlot
 
 DEFAULT_PRIORITY = 100
@@ -58,6 +59,54 @@ class DiagnosticRecoveryManager(RecoveryManagerBase):
     ones) or ``PluginLoadError``; plugin exceptions in cycles are contained.
     """
 
+    PARAMETERS = (
+        Param("safety_reflex_types", [], "aliases of the safety reflexes (level 0, RT)",
+              type="str[]", dynamic=False),
+        Param("evaluator_types", [], "aliases of the evaluators (level 1)", type="str[]",
+              dynamic=False),
+        Param("mitigation_types", [], "aliases of the mitigations (level 1)", type="str[]",
+              dynamic=False),
+    )
+    #: Sub-plugin lists and the plugin kind of their aliases.
+    SUB_PLUGIN_LISTS = {
+        "safety_reflex_types": SAFETY_REFLEX,
+        "evaluator_types": EVALUATOR,
+        "mitigation_types": MITIGATION,
+    }
+    READS = (keys.CMD_VEL, keys.PROPOSAL_TAKEOVER, keys.PROPOSAL_OVERRIDE)
+    WRITES = (keys.CONTROL_OWNER, keys.PROPOSAL_TAKEOVER, keys.PROPOSAL_OVERRIDE)
+
+    def parameter_owners(self):
+        """This manager and every loaded reflex, evaluator and mitigation (each under
+        ``<alias>.<sub_alias>``), for runtime parameter changes."""
+        owners = list(super().parameter_owners())
+        for _, plugin in [*self.reflexes, *self.evaluators, *getattr(self, "mitigations", [])]:
+            owners.extend(plugin.parameter_owners())
+        return owners
+
+    @classmethod
+    def unknown_parameter_keys(cls, keys_: Mapping[str, Any]) -> list[tuple[str, str | None]]:
+        """Unknown keys of the manager and, under ``<sub_alias>.``, of each listed sub-plugin
+        (the class its ``<sub_alias>.plugin`` names; an uninstalled one is not checked)."""
+        sub_aliases = {
+            alias: kind
+            for name, kind in cls.SUB_PLUGIN_LISTS.items()
+            for alias in (keys_.get(name) or [])
+            if isinstance(alias, str)
+        }
+        own = {k: v for k, v in keys_.items() if k.split(".", 1)[0] not in sub_aliases}
+        unknown = list(super().unknown_parameter_keys(own))
+        for alias, kind in sub_aliases.items():
+            prefix = f"{alias}."
+            sub = {k[len(prefix):]: v for k, v in keys_.items() if k.startswith(prefix)}
+            try:
+                sub_cls = load_plugin_class(kind, str(sub.get("plugin", "")), f"{alias}.plugin")
+            except Exception:  # not installed or not set: configure reports it
+                continue
+            for key, closest in sub_cls.unknown_parameter_keys(sub):
+                unknown.append((prefix + key, None if closest is None else prefix + closest))
+        return unknown
+
     def on_initialize(self) -> None:
         self.schedule = ActivationAwareSchedule(self.freq, self._on_activation)
         self._slot = TakeoverSlot.for_cycle(self.context.system_freq)
@@ -70,20 +119,18 @@ class DiagnosticRecoveryManager(RecoveryManagerBase):
         self.reflexes: list[tuple[str, SafetyReflexBase]] = []
         self.evaluators: list[tuple[str, EvaluatorBase]] = []
         mitigations: list[tuple[str, MitigationBase]] = []
+        self.mitigations: list[tuple[str, MitigationBase]] = []
         self._topics: RecoveryTopics | None = None
         try:
             lists = {
-                name: read_str_list(self, name, [])
+                name: list(self.params[name])
                 for name in ("safety_reflex_types", "evaluator_types", "mitigation_types")
             }
             self._check_aliases(lists)
             self.reflexes = self._load(SAFETY_REFLEX, lists["safety_reflex_types"])
             self.evaluators = self._load(EVALUATOR, lists["evaluator_types"])
             loaded = self._load(MITIGATION, lists["mitigation_types"])
-            priorities = {
-                alias: read_int(self, f"{alias}.priority", DEFAULT_PRIORITY, minimum=None)
-                for alias, _ in loaded
-            }
+            priorities = {alias: mitigation.params.priority for alias, mitigation in loaded}
             # Lower first; sorted() is stable, so ties keep the mitigation_types order.
             mitigations = sorted(loaded, key=lambda item: priorities[item[0]])
             for alias, mitigation in mitigations:

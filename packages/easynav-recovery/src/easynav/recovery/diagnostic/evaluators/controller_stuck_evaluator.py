@@ -8,6 +8,7 @@ import math
 
 from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, Odometry, TwistStamped
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.evaluator_base import EvaluatorBase
@@ -17,7 +18,6 @@ from easynav.recovery.navigation_context import (
     navigation_paused,
     protective_stop,
 )
-from easynav.recovery.parameters import read_float
 
 
 class ControllerStuckEvaluator(EvaluatorBase):
@@ -38,12 +38,18 @@ class ControllerStuckEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "controller_stuck"
 
+    PARAMETERS = (
+        Param("linear_velocity_threshold", 0.02,
+              "a command at least this fast counts as an attempt to move", "m/s", ge=0.0),
+        Param("progress_distance_threshold", 0.05,
+              "moving at most this far in the window is being stuck", "m", gt=0.0),
+        Param("stuck_time_threshold", 2.0, "the window", "s", gt=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.linear_velocity_threshold = read_float(self, "linear_velocity_threshold", 0.02)
-        self.progress_distance_threshold = read_float(
-            self, "progress_distance_threshold", 0.05, positive=True
-        )
-        self.stuck_time_threshold = read_float(self, "stuck_time_threshold", 2.0, positive=True)
+        self.linear_velocity_threshold = self.params.linear_velocity_threshold
+        self.progress_distance_threshold = self.params.progress_distance_threshold
+        self.stuck_time_threshold = self.params.stuck_time_threshold
         self._reference: tuple[float, float] | None = None
         self._reference_time = 0.0
         self._level = DiagnosticLevel.OK
