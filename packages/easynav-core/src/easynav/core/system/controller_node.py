@@ -20,11 +20,12 @@ from rclpy.qos import (
 
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
-from easynav.core.plugins.declarations import Param, ParameterValueError
+from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
 from easynav.core.ros.converters import header_to_msg, twist_to_msg
 from easynav.core.system.component_node import ComponentNode, ConfigurationError
+from easynav.core.system.node_declarations import CONTROLLER_NODE_PARAMETERS
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
 from easynav.core.velocity import VelocityOutput
 
@@ -36,38 +37,6 @@ DEPRECATED_LIMIT_PARAMETERS = {
     "max_linear_acc": "max_linear_acc",
     "max_angular_acc": "max_angular_acc",
 }
-
-_LIMIT_DESCRIPTIONS = {
-    "max_linear_vel": ("forward speed limit", "m/s"),
-    "min_linear_vel": ("reverse speed limit (<= 0; 0: never reverse)", "m/s"),
-    "max_angular_vel": ("turn rate limit (either direction)", "rad/s"),
-    "max_linear_acc": ("linear acceleration limit", "m/s²"),
-    "max_linear_decel": ("linear deceleration limit", "m/s²"),
-    "max_angular_acc": ("angular acceleration limit", "rad/s²"),
-    "max_angular_decel": ("angular deceleration limit", "rad/s²"),
-}
-
-
-def _limit_param(name: str, default: float) -> Param:
-    description, unit = _LIMIT_DESCRIPTIONS[name]
-    if name == "min_linear_vel":
-        return Param(f"robot_limits.{name}", default, description, unit, le=0.0)
-    if name.endswith("_vel"):
-        return Param(f"robot_limits.{name}", default, description, unit, ge=0.0)
-    return Param(f"robot_limits.{name}", default, description, unit, gt=0.0)
-
-
-#: controller_node's own parameters.
-CONTROLLER_NODE_PARAMETERS = (
-    *(_limit_param(name, default) for name, default in DEFAULT_ROBOT_LIMITS.items()),
-    Param("cmd_timeout", 0.5, "a controller command older than this brakes to zero (0: off)",
-          "s", ge=0.0, dynamic=False),
-    Param("cmd_vel_keepalive_period", 0.0,
-          "republish the last command at this period, with a QoS deadline (0: off)", "s",
-          ge=0.0, dynamic=False),
-    Param("use_cmd_vel_stamped", False, "publish TwistStamped on cmd_vel_stamped", dynamic=False),
-)
-
 
 class ControllerNode(ComponentNode):
     """controller_node: runs the controller plugin and publishes the one velocity command.

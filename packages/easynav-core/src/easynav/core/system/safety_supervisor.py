@@ -18,7 +18,7 @@ from rclpy.qos import (
 from std_msgs.msg import String
 
 from easynav.core.diagnostics import write_diagnostic
-from easynav.core.plugins.declarations import Param, ParameterValueError, read_parameters
+from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.ros.converters import time_to_msg
 from easynav.core.safety import (
     PARAMETER_TYPES,
@@ -33,27 +33,8 @@ from easynav.core.safety import (
     ros_log_dir,
 )
 from easynav.core.system.component_node import ConfigurationError
+from easynav.core.system.node_declarations import SAFETY_PARAMETERS
 from easynav.core.types import Odometry
-
-#: safety.* parameters of system_node (seed-safety.txt). Runtime changes go through the
-#: frozen-configuration guard.
-SAFETY_PARAMETERS: tuple[Param, ...] = (
-    Param("safety.mode", False, "safety mode: frozen configuration, fail-stop on RT overruns"),
-    Param("safety.lock_memory", False, "lock the process memory (mlockall) before activating"),
-    Param("safety.plc_limits.max_linear_vel", 0.0,
-          "the safety channel's linear speed limit, checked against robot_limits (0: not given)",
-          "m/s", ge=0.0),
-    Param("safety.plc_limits.max_angular_vel", 0.0,
-          "the safety channel's turn rate limit (0: not given)", "rad/s", ge=0.0),
-    Param("safety.heartbeat.period", 0.0, "period of easynav_heartbeat (0: off)", "s", ge=0.0),
-    Param("safety.rt_monitor.max_period_factor", 2.0,
-          "an RT cycle longer than this many periods is late", gt=1.0),
-    Param("safety.rt_monitor.max_late_cycles", 10,
-          "late RT cycles in a row before the monitor's ERROR", ge=1),
-    Param("safety.status.timeout", 0.0,
-          "the safety channel's state is stale after this long (0: not read)", "s", ge=0.0),
-    Param("safety.max_pose_age", 1.0, "oldest usable robot_pose (0: off)", "s", ge=0.0),
-)
 
 #: Defaults by name (read-only view for tools and tests).
 SAFETY_DEFAULTS: dict[str, Any] = {param.name: param.default for param in SAFETY_PARAMETERS}

@@ -11,14 +11,14 @@ from rclpy.node import Node
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import String
 
-from easynav.core.goals.goal_manager_params import GOAL_MANAGER_PARAMETERS
-from easynav.core.plugins.declarations import Param, ParameterValueError, read_parameters
+from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.robot import RobotGeometry, RobotGeometryRegistry
 from easynav.core.system.component_node import ComponentNode
 from easynav.core.system.controller_node import ControllerNode
 from easynav.core.system.goal_manager_extension import GoalManagerExtension
 from easynav.core.system.localizer_node import LocalizerNode
 from easynav.core.system.maps_manager_node import MapsManagerNode
+from easynav.core.system.node_declarations import SYSTEM_PARAMETERS, SYSTEM_PARAMETERS_BY_NAME
 from easynav.core.system.node_parameters import NodeParameters
 from easynav.core.system.planner_node import PlannerNode
 from easynav.core.system.recovery_node import RecoveryNode
@@ -28,34 +28,6 @@ from easynav.core.system.sensors_node import SensorsNode
 from easynav.core.system.system_context import SystemContext
 from easynav.core.system.system_requests import SystemRequests
 from easynav.core.tf import TFInfo, TFListener, get_tf_buffer
-
-#: system_node's own parameters (REFERENCE.md §1); the goal manager's follow.
-SYSTEM_PARAMETERS: tuple[Param, ...] = (
-    Param("use_real_time", True, "RT loop at SCHED_FIFO priority when allowed", dynamic=False),
-    Param("rt_freq", 200.0, "frequency of the RT cycle", "Hz", gt=0.0, dynamic=False),
-    Param("freq", 200.0, "frequency of the non-RT cycle", "Hz", gt=0.0, dynamic=False),
-    Param("spin_time_rt", 0.001, "time the RT loop spins its executor per cycle", "s", ge=0.0,
-          dynamic=False),
-    Param("spin_time_nort", 0.001, "time the non-RT loop spins its executor per cycle", "s",
-          ge=0.0, dynamic=False),
-    Param("tf_prefix", "", "prefix of every frame name (multi-robot)", dynamic=False),
-    Param("map_frame", "map", "the map frame", dynamic=False),
-    Param("odom_frame", "odom", "the odometry frame", dynamic=False),
-    Param("robot_frame", "base_link", "the robot frame", dynamic=False),
-    Param("robot_footprint_frame", "base_footprint", "the robot's footprint frame",
-          dynamic=False),
-    Param("world_frame", "earth", "the world frame", dynamic=False),
-    Param("robot_geometry.radius", 0.3, "circumscribed radius of the robot", "m", ge=0.0,
-          dynamic=False),
-    Param("robot_geometry.inscribed_radius", 0.3,
-          "largest circle inside the robot (default: robot_geometry.radius)", "m", ge=0.0,
-          dynamic=False),
-    Param("robot_geometry.height", 0.5, "top of the robot above the robot frame", "m", ge=0.0,
-          dynamic=False),
-    *GOAL_MANAGER_PARAMETERS,
-)
-
-SYSTEM_PARAMETERS_BY_NAME = {param.name: param for param in SYSTEM_PARAMETERS}
 
 #: Defaults by name (read-only view for tools and tests).
 SYSTEM_DEFAULTS: dict[str, Any] = {param.name: param.default for param in SYSTEM_PARAMETERS}
