@@ -68,3 +68,18 @@ def test_robot_geometry_records_the_fields_the_user_set(active):
     assert geometry.is_set("radius") and geometry.is_set("height")
     assert not geometry.is_set("inscribed_radius")
     assert get_robot_geometry(active.system_node.controller_node) == geometry
+
+
+def test_a_reconfiguration_is_checked_by_the_same_rules(active):
+    actions = active.system_node.recovery_node.actions
+    assert not actions.request_reconfigure(
+        [("controller_node", "robot_limits.max_linear_vel", -1.0)], "bad slow-down"
+    )
+    assert not actions.request_reconfigure(
+        [("controller_node", "dummy.cycle_time_rt", float("nan"))], "bad"
+    )
+    check = active.system_node.system.services["check_reconfigure"]
+    ok, why = check([("controller_node", "robot_limits.max_linear_vel", -1.0)])
+    assert not ok and why == "controller_node.robot_limits.max_linear_vel = -1.0: must be >= 0"
+    # Read at configure only, yet changeable through a reconfiguration (plugins reloaded).
+    assert check([("controller_node", "cmd_timeout", 0.3)]) == (True, "")

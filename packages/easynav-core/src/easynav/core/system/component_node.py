@@ -170,14 +170,16 @@ class ComponentNode(LifecycleNode):
             return None
         return best
 
-    def check_parameter_change(self, name: str, value: Any) -> Any:
+    def check_parameter_change(self, name: str, value: Any, reconfiguring: bool = False) -> Any:
         """``value`` for parameter ``name`` converted and checked against its declaration (a node
         parameter or a loaded plugin's); raises :class:`ParameterValueError` with the reason.
-        Names nothing declares pass unchanged (``<alias>.plugin``, the types lists)."""
+        Names nothing declares pass unchanged (``<alias>.plugin``, the types lists).
+        ``reconfiguring``: the change goes through a reconfiguration (the plugins are reloaded),
+        so parameters read only at configure may change too."""
         for param in self.NODE_PARAMETERS:
             if name == param.name or name in param.deprecated:
                 full = f"{self.get_name()}.{name}"
-                if not param.dynamic and self.active:
+                if not param.dynamic and self.active and not reconfiguring:
                     raise ParameterValueError(
                         f"{full}: cannot change while active (reconfigure instead)"
                     )
@@ -188,6 +190,9 @@ class ComponentNode(LifecycleNode):
         if found is None:
             return value
         owner, relative = found
+        param = owner.parameter_declaration(relative)
+        if reconfiguring and param is not None:
+            return param.convert(value, f"{owner.parameter_prefix}.{relative}")
         return owner.validate_parameter(relative, value)
 
     def check_node_parameter(self, name: str, value: Any) -> None:
