@@ -24,6 +24,7 @@ class AmclConvergenceEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "localizer.amcl"
 
+    READS = (keys.AMCL_COVARIANCE_TRACE,)
     PARAMETERS = (
         Param("covariance_threshold", 1.0, "a covariance trace above this is an ERROR", "", gt=0.0),
     )

@@ -38,6 +38,10 @@ class ControllerStuckEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "controller_stuck"
 
+    READS = (
+        keys.GOALS, keys.NAVIGATION_STATE, keys.CMD_VEL, keys.ROBOT_POSE, keys.NAVIGATION_PAUSED,
+        keys.SAFETY_STATUS, keys.CONTROL_OWNER,
+    )
     PARAMETERS = (
         Param("linear_velocity_threshold", 0.02,
               "a command at least this fast counts as an attempt to move", "m/s", ge=0.0),

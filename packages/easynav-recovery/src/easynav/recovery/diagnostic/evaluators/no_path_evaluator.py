@@ -21,6 +21,7 @@ class NoPathEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "planner"
 
+    READS = (keys.GOALS, keys.NAVIGATION_STATE, keys.PATH)
     PARAMETERS = (
         Param("debounce_duration", 1.0,
               "WARN becomes ERROR after this long without a path (0: at once)", "s", ge=0.0),

@@ -38,6 +38,10 @@ class ObstacleTooCloseEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "obstacle_proximity"
 
+    READS = (
+        keys.ROBOT_POSE, keys.GOALS, keys.NAVIGATION_STATE, keys.NAVIGATION_PAUSED,
+        keys.SAFETY_STATUS,
+    )
     PARAMETERS = (
         Param("safe_distance", 0.6, "a point closer than this to the robot centre is too close",
               "m", gt=0.0),

@@ -25,6 +25,7 @@ class SafetyChannelEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "safety_channel"
 
+    READS = (keys.SAFETY_STATUS,)
     PARAMETERS = (
         Param("max_stop_time", 0.0, "a protective stop this long is an ERROR (0: never)",
               "s", ge=0.0),

@@ -30,6 +30,8 @@ class AdvanceRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    READS = (keys.ROBOT_POSE,)
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
     PARAMETERS = (
         Param("advance_distance", 0.3, "distance driven forward per attempt", "m", gt=0.0),
         Param("advance_speed", 0.1, "forward speed", "m/s", gt=0.0),

@@ -26,6 +26,8 @@ class AmclRelocalizeMitigation(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    READS = (keys.AMCL_COVARIANCE_TRACE,)
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
     PARAMETERS = (
         Param("rotation_speed", 0.3, "turn rate while relocalising", "rad/s"),
         Param("timeout", 5.0, "FAILED after this long", "s", gt=0.0),

@@ -8,6 +8,7 @@ from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_arbiter import is_rate_diagnostic
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
@@ -28,6 +29,7 @@ class HumanAssistanceRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
     PARAMETERS = (
         Param("timeout", 0.0, "FAILED after waiting this long (0: waits forever)", "s", ge=0.0),
         Param("ignored_hardware_ids", ["ros_graph"],

@@ -10,6 +10,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Twist
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
 from easynav.recovery.diagnostic.recovery_status import RecoveryStatus
@@ -35,6 +36,7 @@ class SafeRetreatRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
     PARAMETERS = (
         Param("safe_distance", 0.6, "SUCCEEDED this far from the nearest obstacle (robot centre)",
               "m", gt=0.0),

@@ -8,6 +8,7 @@ from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_arbiter import is_rate_diagnostic
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
@@ -26,6 +27,7 @@ class ShutdownRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
     PARAMETERS = (
         Param("handled_hardware_ids", ["ros_graph"],
               "hardware ids of the ERRORs that shut EasyNav down", "", type="str[]"),

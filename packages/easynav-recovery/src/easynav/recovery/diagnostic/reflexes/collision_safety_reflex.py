@@ -12,6 +12,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Twist
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.safety_reflex_base import SafetyReflexBase
 from easynav.recovery.fused_point_cloud import FusedPointCloud
 
@@ -45,6 +46,8 @@ class CollisionSafetyReflex(SafetyReflexBase):
     Thread contract: as :class:`SafetyReflexBase` (``check`` in the RT thread).
     """
 
+    READS = (keys.CMD_VEL, keys.NAVIGATION_PAUSED, keys.SAFETY_STATUS, keys.PROPOSAL_TAKEOVER)
+    WRITES = (keys.PROPOSAL_OVERRIDE,)
     PARAMETERS = (
         Param("brake_acc", 0.5, "deceleration assumed for the stopping distance", "m/s²", gt=0.0),
         Param("safety_margin", 0.1, "margin added to robot_geometry.radius", "m", ge=0.0),
