@@ -58,8 +58,16 @@ def test_robot_limits_change_at_runtime_within_their_rules(active):
 
 
 def test_a_parameter_read_at_configure_is_refused_while_active(active):
-    result = set_param(active.system_node.controller_node, "cmd_timeout", 0.3)
+    result = set_param(active.system_node.controller_node, "cmd_vel_keepalive_period", 0.3)
     assert not result.successful and "cannot change while active" in result.reason
+
+
+def test_cmd_timeout_changes_at_runtime_within_its_rules(active):
+    node = active.system_node.controller_node
+    assert set_param(node, "cmd_timeout", 0.3).successful
+    assert node.velocity_output.cmd_timeout == 0.3
+    result = set_param(node, "cmd_timeout", 0.01)  # not longer than the controller's period
+    assert not result.successful and "must be longer than the controller's period" in result.reason
 
 
 def test_robot_geometry_records_the_fields_the_user_set(active):
@@ -82,4 +90,4 @@ def test_a_reconfiguration_is_checked_by_the_same_rules(active):
     ok, why = check([("controller_node", "robot_limits.max_linear_vel", -1.0)])
     assert not ok and why == "controller_node.robot_limits.max_linear_vel = -1.0: must be >= 0"
     # Read at configure only, yet changeable through a reconfiguration (plugins reloaded).
-    assert check([("controller_node", "cmd_timeout", 0.3)]) == (True, "")
+    assert check([("controller_node", "cmd_vel_keepalive_period", 0.3)]) == (True, "")

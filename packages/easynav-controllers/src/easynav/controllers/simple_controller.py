@@ -18,22 +18,6 @@ from easynav.core.robot import RobotLimits
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
 
-#: The original's own limits, deprecated in favour of controller_node.robot_limits.*: unset (NaN)
-#: by default; set, controller_node applies each to its robot_limits field where the user did
-#: not set that field (explicit robot_limits and runtime changes win).
-DEPRECATED_LIMITS = (
-    Param("max_linear_speed", math.nan, "deprecated: controller_node robot_limits.max_linear_vel",
-          "m/s", ge=0.0, allow_nan=True),
-    Param("max_angular_speed", math.nan,
-          "deprecated: controller_node robot_limits.max_angular_vel", "rad/s", ge=0.0,
-          allow_nan=True),
-    Param("max_linear_acc", math.nan, "deprecated: controller_node robot_limits.max_linear_acc",
-          "m/s²", ge=0.0, allow_nan=True),
-    Param("max_angular_acc", math.nan,
-          "deprecated: controller_node robot_limits.max_angular_acc", "rad/s²", ge=0.0,
-          allow_nan=True),
-)
-
 #: The follower's parameters (defaults of the original, CATALOGUE §SimpleController).
 FOLLOWER_PARAMETERS = ("look_ahead_dist", "tolerance_dist", "final_goal_angle_tolerance", "k_rot",
                        "linear_kp", "linear_ki", "linear_kd", "angular_kp", "angular_ki",
@@ -73,7 +57,6 @@ class SimpleController(ControllerMethodBase):
         Param("angular_kp", 1.5, "angular PID: proportional gain"),
         Param("angular_ki", 0.03, "angular PID: integral gain"),
         Param("angular_kd", 0.08, "angular PID: derivative gain"),
-        *DEPRECATED_LIMITS,
     )
     TOPICS = ()
     READS = (PATH, ROBOT_POSE, GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW)

@@ -88,6 +88,14 @@ class ControllerNode(ComponentNode):
             raise ConfigurationError("; ".join(errors))
 
     def check_node_parameter(self, name: str, value: Any) -> None:
+        if name == "cmd_timeout":
+            for lp in self.plugins:
+                period = 1.0 / lp.plugin.rt_freq
+                if 0.0 < value <= period:
+                    raise ParameterValueError(
+                        f"{self.get_name()}.cmd_timeout = {value:g} s must be longer than the "
+                        f"controller's period ({lp.alias}.rt_freq = {lp.plugin.rt_freq:g} Hz)"
+                    )
         if name.startswith("robot_limits."):
             field = name.removeprefix("robot_limits.")
             errors = replace(self.robot_limits, **{field: value}).validation_errors(
@@ -97,11 +105,16 @@ class ControllerNode(ComponentNode):
                 raise ParameterValueError("; ".join(errors))
 
     def on_node_parameter_changed(self, name: str, value: Any) -> None:
-        """A runtime change of ``robot_limits.*`` is in force from the next RT cycle."""
+        """A runtime change of ``robot_limits.*`` or ``cmd_timeout`` is in force from the next
+        RT cycle."""
         if name.startswith("robot_limits."):
             self.robot_limits = replace(
                 self.robot_limits, **{name.removeprefix("robot_limits."): float(value)}
             )
+        elif name == "cmd_timeout":
+            self.cmd_timeout = float(value)
+            if self.velocity_output is not None:
+                self.velocity_output.set_cmd_timeout(self.cmd_timeout)
 
     def after_plugins_loaded(self) -> None:
         self._apply_deprecated_limits()

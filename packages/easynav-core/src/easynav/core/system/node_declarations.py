@@ -35,7 +35,7 @@ def _limit_param(name: str, default: float) -> Param:
 CONTROLLER_NODE_PARAMETERS = (
     *(_limit_param(name, default) for name, default in DEFAULT_ROBOT_LIMITS.items()),
     Param("cmd_timeout", 0.5, "a controller command older than this brakes to zero (0: off)",
-          "s", ge=0.0, dynamic=False),
+          "s", ge=0.0),
     Param("cmd_vel_keepalive_period", 0.0,
           "republish the last command at this period, with a QoS deadline (0: off)", "s",
           ge=0.0, dynamic=False),

@@ -118,7 +118,8 @@ class SafetySupervisor:
         try:
             p = read_parameters(SAFETY_PARAMETERS, node.params, "")
         except ParameterValueError as exc:
-            raise ConfigurationError(f"system_node.{exc}") from None
+            # Safety errors name their parameter as node/name (seed-safety.txt).
+            raise ConfigurationError(f"system_node/{exc}") from None
         self.mode = bool(p["safety.mode"])
         parameters = self.effective_parameters()
         errors = configuration_errors(
