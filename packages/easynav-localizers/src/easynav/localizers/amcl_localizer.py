@@ -105,6 +105,7 @@ class AMCLLocalizer(LocalizerMethodBase):
     Exceptions: :class:`PluginConfigurationError` naming the parameter.
     """
 
+    NEEDS_MAPS = ("simple_map",)
     PARAMETERS = AMCL_PARAMETERS
     TOPICS = (
         Topic("odom", "nav_msgs/msg/Odometry", "sub", "reliable, keep last 5",

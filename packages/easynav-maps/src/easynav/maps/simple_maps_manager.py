@@ -66,6 +66,7 @@ class SimpleMapsManager(MapsManagerBase):
     :class:`PluginConfigurationError` naming the parameter and the file.
     """
 
+    PROVIDES_MAPS = ("simple_map",)
     PARAMETERS = (
         Param("package", "", "package holding the map (empty: map_path_file is a path)",
               dynamic=False),

@@ -48,6 +48,7 @@ class SimplePlanner(PlannerMethodBase):
     for unreachable goals (it reports them).
     """
 
+    NEEDS_MAPS = ("simple_map",)
     PARAMETERS = (
         Param("clearance_distance", 0.2, "extra distance kept from obstacles beyond the radius",
               "m", ge=0.0),
