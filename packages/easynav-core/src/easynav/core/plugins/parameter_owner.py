@@ -39,6 +39,11 @@ class ParameterOwner:
     #: Keys accepted under the owner's prefix without a declaration (``plugin``: the plugin
     #: name, read by the host).
     ACCEPTED_KEYS: ClassVar[tuple[str, ...]] = ("plugin",)
+    #: For an owner that hosts sub-plugins: each parameter listing sub-plugin aliases and the
+    #: plugin kind (``PluginKind``) of those aliases, e.g. ``{"filters": COSTMAP_FILTER}``. The
+    #: sub-plugin of alias ``a`` is named by ``a.plugin`` and reads its parameters under
+    #: ``<prefix>.a.``; :meth:`unknown_parameter_keys` checks them with its class.
+    SUB_PLUGIN_LISTS: ClassVar[dict[str, Any]] = {}
 
     params: ParameterValues
     parameter_prefix: str = ""
@@ -68,10 +73,33 @@ class ParameterOwner:
         """Keys of a params file under this owner's prefix (relative names, with their values)
         that nothing declares: ``(key, closest declared name or None)`` each.
 
-        Owners that host sub-plugins override it to check their sub-plugins' keys as well.
+        Keys under a sub-plugin alias (see :attr:`SUB_PLUGIN_LISTS`) are checked by the class
+        its ``<alias>.plugin`` names (not checked when that plugin is not installed: configure
+        reports it).
         """
+        from easynav.core.plugins.discovery import load_plugin_class
+
+        sub_aliases = {
+            alias: kind
+            for name, kind in cls.SUB_PLUGIN_LISTS.items()
+            for alias in (keys.get(name) or [])
+            if isinstance(alias, str)
+        }
         known = declared_names(cls.parameter_declarations()) | set(cls.ACCEPTED_KEYS)
-        return [(key, closest_name(key, known)) for key in keys if key not in known]
+        unknown = [
+            (key, closest_name(key, known)) for key in keys
+            if key not in known and key.split(".", 1)[0] not in sub_aliases
+        ]
+        for alias, kind in sub_aliases.items():
+            prefix = f"{alias}."
+            sub = {k[len(prefix):]: v for k, v in keys.items() if k.startswith(prefix)}
+            try:
+                sub_cls = load_plugin_class(kind, str(sub.get("plugin", "")), f"{alias}.plugin")
+            except (LookupError, ImportError):
+                continue
+            for key, closest in sub_cls.unknown_parameter_keys(sub):
+                unknown.append((prefix + key, None if closest is None else prefix + closest))
+        return unknown
 
     # -- reading -------------------------------------------------------------------------------
     def read_declared_parameters(self, access: Any, prefix: str, warn: Any = None) -> None:
@@ -106,10 +134,18 @@ class ParameterOwner:
         Owners that read ``self.params`` every cycle need nothing here; those that derive
         state from a parameter rebuild it."""
 
-    def parameter_owners(self) -> Iterable[tuple[str, ParameterOwner]]:
+    def sub_plugins(self) -> Iterable[ParameterOwner]:
+        """The sub-plugins this owner has loaded (none by default; hosts of sub-plugins return
+        theirs)."""
+        return ()
+
+    def parameter_owners(self) -> list[tuple[str, ParameterOwner]]:
         """``(prefix, owner)`` of this owner and of every sub-plugin it hosts, so that a host
         node routes ``<prefix>.<name>`` changes to the right one (longest prefix first)."""
-        return [(self.parameter_prefix, self)]
+        owners: list[tuple[str, ParameterOwner]] = [(self.parameter_prefix, self)]
+        for sub in self.sub_plugins():
+            owners.extend(sub.parameter_owners())
+        return owners
 
 
 def closest_name(name: str, known: Iterable[str]) -> str | None:

@@ -46,7 +46,8 @@ def installed_plugins() -> list[InstalledPlugin]:
             cls = load_plugin_class(kind, ep.name, f"{group}:{ep.name}")
             dist = ep.dist.metadata["Name"] if ep.dist else "?"
             plugins.append(InstalledPlugin(ep.name, group, dist, cls))
-    return sorted(plugins, key=lambda p: (p.distribution, p.name))
+    # Stable: plugins of one class keep their entry-point order (the first name is canonical).
+    return sorted(plugins, key=lambda p: p.distribution)
 
 
 def find_plugin(name: str) -> InstalledPlugin:

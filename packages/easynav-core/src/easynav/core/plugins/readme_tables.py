@@ -61,17 +61,29 @@ def distribution_root(cls: type) -> Path | None:
     return None
 
 
-def documented_plugins() -> list[tuple[InstalledPlugin, Path]]:
-    """Every installed plugin that declares parameters and whose distribution is a source tree
-    here, with the README it belongs in."""
-    result = []
+def documented_plugins() -> list[tuple[list[InstalledPlugin], Path]]:
+    """Every installed plugin class that declares parameters and whose distribution is a source
+    tree here, with the README it belongs in. A class registered under several names (a renamed
+    plugin keeping its old name) comes once, with all its names (sorted)."""
+    by_class: dict[tuple[str, type], list[InstalledPlugin]] = {}
     for plugin in installed_plugins():
         if not declarations_of(plugin.cls):
             continue  # e.g. perception handlers: nothing declared
-        root = distribution_root(plugin.cls)
+        by_class.setdefault((plugin.group, plugin.cls), []).append(plugin)
+    result = []
+    for names in by_class.values():
+        root = distribution_root(names[0].cls)
         if root is not None:
-            result.append((plugin, root / "README.md"))
+            result.append((sorted(names, key=lambda p: p.name), root / "README.md"))
     return result
+
+
+def _documented_name(text: str, names: list[InstalledPlugin]) -> InstalledPlugin:
+    # The name whose block the README has, else the first name.
+    for plugin in names:
+        if BEGIN.format(name=plugin.name) in text:
+            return plugin
+    return names[0]
 
 
 def block(plugin: InstalledPlugin) -> str:
@@ -132,16 +144,16 @@ def node_tables() -> list[InstalledPlugin]:
 
 def updates() -> list[ReadmeUpdate]:
     """The regenerated text of every README that documents a plugin."""
-    by_readme: dict[Path, list[InstalledPlugin]] = {}
+    by_readme: dict[Path, list[list[InstalledPlugin]]] = {}
     core_readme = Path(__file__).resolve().parents[4] / "README.md"
     if core_readme.is_file():
-        by_readme[core_readme] = node_tables()
-    for plugin, readme in documented_plugins():
-        by_readme.setdefault(readme, []).append(plugin)
+        by_readme[core_readme] = [[table] for table in node_tables()]
+    for names, readme in documented_plugins():
+        by_readme.setdefault(readme, []).append(names)
     result = []
-    for readme, plugins in sorted(by_readme.items()):
+    for readme, classes in sorted(by_readme.items()):
         old = readme.read_text() if readme.is_file() else f"# {readme.parent.name}\n"
-        new, added = regenerate(old, plugins)
+        new, added = regenerate(old, [_documented_name(old, names) for names in classes])
         result.append(ReadmeUpdate(readme, old, new, added))
     return result
 

@@ -5,7 +5,6 @@ recovery system driven by diagnostics, made of reflex, evaluator and mitigation 
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
 from typing import Any
 
 from easynav.core.diagnostics import read_diagnostics, write_diagnostic
@@ -76,36 +75,14 @@ class DiagnosticRecoveryManager(RecoveryManagerBase):
     READS = (keys.CMD_VEL, keys.PROPOSAL_TAKEOVER, keys.PROPOSAL_OVERRIDE)
     WRITES = (keys.CONTROL_OWNER, keys.PROPOSAL_TAKEOVER, keys.PROPOSAL_OVERRIDE)
 
-    def parameter_owners(self):
-        """This manager and every loaded reflex, evaluator and mitigation (each under
-        ``<alias>.<sub_alias>``), for runtime parameter changes."""
-        owners = list(super().parameter_owners())
-        for _, plugin in [*self.reflexes, *self.evaluators, *getattr(self, "mitigations", [])]:
-            owners.extend(plugin.parameter_owners())
-        return owners
-
-    @classmethod
-    def unknown_parameter_keys(cls, keys_: Mapping[str, Any]) -> list[tuple[str, str | None]]:
-        """Unknown keys of the manager and, under ``<sub_alias>.``, of each listed sub-plugin
-        (the class its ``<sub_alias>.plugin`` names; an uninstalled one is not checked)."""
-        sub_aliases = {
-            alias: kind
-            for name, kind in cls.SUB_PLUGIN_LISTS.items()
-            for alias in (keys_.get(name) or [])
-            if isinstance(alias, str)
-        }
-        own = {k: v for k, v in keys_.items() if k.split(".", 1)[0] not in sub_aliases}
-        unknown = list(super().unknown_parameter_keys(own))
-        for alias, kind in sub_aliases.items():
-            prefix = f"{alias}."
-            sub = {k[len(prefix):]: v for k, v in keys_.items() if k.startswith(prefix)}
-            try:
-                sub_cls = load_plugin_class(kind, str(sub.get("plugin", "")), f"{alias}.plugin")
-            except Exception:  # not installed or not set: configure reports it
-                continue
-            for key, closest in sub_cls.unknown_parameter_keys(sub):
-                unknown.append((prefix + key, None if closest is None else prefix + closest))
-        return unknown
+    def sub_plugins(self) -> list[MethodBase]:
+        """Every loaded reflex, evaluator and mitigation (runtime parameter changes of
+        ``recovery_manager.<alias>.*`` go to them)."""
+        loaded = [
+            *getattr(self, "reflexes", []), *getattr(self, "evaluators", []),
+            *getattr(self, "mitigations", []),
+        ]
+        return [plugin for _, plugin in loaded]
 
     def on_initialize(self) -> None:
         self.schedule = ActivationAwareSchedule(self.freq, self._on_activation)
