@@ -19,7 +19,14 @@ from rclpy.qos import (
 )
 
 from easynav.core.diagnostics import write_diagnostic
-from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
+from easynav.core.nav_state_keys import (
+    CMD_VEL,
+    MOTION_INHIBITED,
+    NAVIGATION_PAUSED,
+    PROPOSAL_OVERRIDE,
+    PROPOSAL_TAKEOVER,
+    SAFETY_STATUS,
+)
 from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
@@ -194,8 +201,8 @@ class ControllerNode(ComponentNode):
     def limits_in_force(self) -> RobotLimits:
         """robot_limits, cut down by a safely limited speed when the safety channel says so."""
         limits = self.robot_limits
-        if self.nav_state.has("safety_status"):
-            state = self.nav_state.get("safety_status", SafetyChannelState)
+        if self.nav_state.has(SAFETY_STATUS):
+            state = self.nav_state.get(SAFETY_STATUS, SafetyChannelState)
             if state.valid and state.speed_limited:
                 limits = limits.cut_down(state.max_linear_vel, state.max_angular_vel)
         return limits
@@ -209,7 +216,7 @@ class ControllerNode(ComponentNode):
             if not ok:
                 # A failing controller stops the robot: a new zero command (braked smoothly).
                 now = self.now_seconds()
-                self.nav_state.set("cmd_vel", TwistStamped(Header(now, ""), Twist()))
+                self.nav_state.set(CMD_VEL, TwistStamped(Header(now, ""), Twist()))
 
     def publish_cycle(self) -> None:
         """Mux → smoother → guard → publish. RT thread, after the recovery system's RT cycle."""
@@ -218,12 +225,12 @@ class ControllerNode(ComponentNode):
             return
         nav_state = self.nav_state
         now = self.now_seconds()
-        controller_cmd = nav_state.get("cmd_vel") if nav_state.has("cmd_vel") else None
+        controller_cmd = nav_state.get(CMD_VEL) if nav_state.has(CMD_VEL) else None
         takeover = nav_state.get(PROPOSAL_TAKEOVER) if nav_state.has(PROPOSAL_TAKEOVER) else None
         override = nav_state.get(PROPOSAL_OVERRIDE) if nav_state.has(PROPOSAL_OVERRIDE) else None
-        paused = bool(nav_state.get_or("navigation_paused", False))
-        safety = nav_state.get("safety_status") if nav_state.has("safety_status") else None
-        inhibited = bool(nav_state.get_or("motion_inhibited", False))
+        paused = bool(nav_state.get_or(NAVIGATION_PAUSED, False))
+        safety = nav_state.get(SAFETY_STATUS) if nav_state.has(SAFETY_STATUS) else None
+        inhibited = bool(nav_state.get_or(MOTION_INHIBITED, False))
         output.set_limits(self.limits_in_force())
         command = output.cycle(now, controller_cmd, takeover, override, paused, safety, inhibited)
         # Proposals last one cycle.
