@@ -25,7 +25,7 @@ class ControllerMethodBase(MethodBase):
     #: each to the robot_limits field it stands for where the user did not set that field
     #: (explicit robot_limits and runtime changes win). Controllers use only
     #: :meth:`get_robot_limits`.
-    PARAMETERS = (
+    DEPRECATED_PARAMETERS = (
         Param("max_linear_speed", math.nan,
               "deprecated: controller_node robot_limits.max_linear_vel", "m/s", ge=0.0,
               allow_nan=True, dynamic=False),

@@ -36,6 +36,8 @@ class ParameterOwner:
     PARAMETERS: ClassVar[tuple[Param, ...]] = ()
     #: Parameters every instance of the family has, before each class's own (rt_freq, freq).
     BASE_PARAMETERS: ClassVar[tuple[Param, ...]] = ()
+    #: Deprecated parameters a family still accepts, listed after every class's own.
+    DEPRECATED_PARAMETERS: ClassVar[tuple[Param, ...]] = ()
     #: Keys accepted under the owner's prefix without a declaration (``plugin``: the plugin
     #: name, read by the host).
     ACCEPTED_KEYS: ClassVar[tuple[str, ...]] = ("plugin",)
@@ -52,13 +54,16 @@ class ParameterOwner:
     @classmethod
     def parameter_declarations(cls) -> tuple[Param, ...]:
         """Every parameter of this class: the family's base ones, then each class's own (base
-        classes first; a subclass's declaration replaces a base's of the same name)."""
+        classes first; a subclass's declaration replaces a base's of the same name), then the
+        family's deprecated ones."""
         groups = [cls.BASE_PARAMETERS]
         for klass in reversed(cls.__mro__):
             own = klass.__dict__.get("PARAMETERS")
             if own:
                 groups.append(own)
-        return merge_declarations(groups)
+        own = merge_declarations(groups)
+        names = {param.name for param in own}
+        return own + tuple(p for p in cls.DEPRECATED_PARAMETERS if p.name not in names)
 
     @classmethod
     def parameter_declaration(cls, name: str) -> Param | None:
