@@ -125,11 +125,19 @@ class _NodeParameters:
 
 
 def node_tables() -> list[InstalledPlugin]:
-    """The node-level tables: ``controller_node``, ``system_node``, ``system_node.safety``."""
+    """The node-level tables: ``controller_node``, ``system_node``, ``system_node.safety``,
+    ``sensors_node``."""
+    from dataclasses import replace
+
+    from easynav.core.sensors.sensor_parameters import SENSOR_PARAMETERS, SENSORS_NODE_PARAMETERS
     from easynav.core.system.node_declarations import (
         CONTROLLER_NODE_PARAMETERS,
         SAFETY_PARAMETERS,
         SYSTEM_PARAMETERS,
+    )
+
+    sensors = SENSORS_NODE_PARAMETERS + tuple(
+        replace(p, name=f"<id>.{p.name}") for p in SENSOR_PARAMETERS
     )
 
     return [
@@ -138,6 +146,7 @@ def node_tables() -> list[InstalledPlugin]:
             ("controller_node", CONTROLLER_NODE_PARAMETERS),
             ("system_node", SYSTEM_PARAMETERS),
             ("system_node.safety", SAFETY_PARAMETERS),
+            ("sensors_node", sensors),
         )
     ]
 
