@@ -224,7 +224,13 @@ class ComponentNode(LifecycleNode):
         found = self._owner_of(name)
         if found is not None:
             owner, relative = found
-            owner.apply_parameter(relative, value)
+            try:
+                owner.apply_parameter(relative, value)
+            except Exception as exc:  # the value is set; a plugin failing to take it is reported
+                self.get_logger().error(
+                    f"{name} = {value!r}: the plugin failed to apply it: "
+                    f"{type(exc).__name__}: {exc}"
+                )
 
     def on_node_parameter_changed(self, name: str, value: Any) -> None:
         """A node parameter changed at runtime (validated; ``node_values`` updated)."""
