@@ -55,6 +55,28 @@ def test_non_rt_frequency_checked_against_system_freq(params_file, runtime_facto
     assert "dummy.freq" in rt.error and "system_node.freq" in rt.error
 
 
+def test_only_frequencies_in_use_are_checked_against_the_system_cycles(
+    params_file, runtime_factory
+):
+    # A 5 Hz non-RT cycle: the controller has no non-RT part, so its freq (a default of 10 Hz
+    # every plugin declares) schedules nothing and is no error, neither when the plugin loads nor
+    # in the configuration checks of the safety supervisor.
+    document = system_params(
+        **{
+            "system_node.freq": 5.0,
+            "maps_manager_node.dummy.freq": 5.0,
+            "recovery_node.recovery_manager.freq": 5.0,
+        }
+    )
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    in_use = rt.system_node.system.frequencies_in_use
+    assert ("controller_node", "dummy.rt_freq") in in_use
+    assert ("controller_node", "dummy.freq") not in in_use
+    assert ("planner_node", "dummy.freq") in in_use
+    assert ("planner_node", "dummy.rt_freq") not in in_use
+
+
 @pytest.mark.parametrize("value", [0.0, -5.0, float("nan"), float("inf")])
 def test_frequency_must_be_finite_and_positive(params_file, runtime_factory, value):
     document = system_params(**{"planner_node.dummy.freq": value})

@@ -146,6 +146,8 @@ class ComponentNode(LifecycleNode):
             robot_geometry=self.system.robot_geometry,
             robot_limits=self.system.robot_limits,
             services=self.system.services,
+            rt_node=self.system.rt_node,
+            frequencies_in_use=self.system.frequencies_in_use,
         )
 
     def plugin_aliases(self) -> list[tuple[str, str]]:
