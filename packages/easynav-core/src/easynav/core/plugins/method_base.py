@@ -151,6 +151,11 @@ class MethodBase:
     def on_cleanup(self) -> None:
         """Release what ``on_initialize`` created (called on cleanup)."""
 
+    def cleanup(self) -> None:
+        """What hosts call on cleanup: :meth:`on_cleanup`, then what a base class created in
+        ``initialize`` (e.g. a localizer's ``initialpose`` subscription). Configuring thread."""
+        self.on_cleanup()
+
     def on_activate(self) -> None:
         """EasyNav becomes active (its cycles start). Lifecycle thread, loops not cycling."""
 

@@ -205,7 +205,7 @@ class ComponentNode(LifecycleNode):
         """Let every plugin release its resources, then forget them."""
         for lp in self.plugins:
             try:
-                lp.plugin.on_cleanup()
+                lp.plugin.cleanup()
             except Exception as exc:
                 self.get_logger().warning(f"{lp.alias}: on_cleanup failed: {exc}")
         self.plugins = []
