@@ -102,8 +102,12 @@ def test_every_localizer_subscribes_initialpose_on_its_node(ros, params_file, ru
     node = ros.create_node("initial_pose_sender")
     publisher = node.create_publisher(PoseWithCovarianceStamped, "initialpose", 10)
     assert ros.spin_until(lambda: publisher.get_subscription_count() > 0, timeout=5.0)
-    (info,) = node.get_subscriptions_info_by_topic("/initialpose")
-    assert info.node_name == "localizer_node"
+
+    def subscribers() -> list[str]:
+        return [i.node_name for i in node.get_subscriptions_info_by_topic("/initialpose")]
+
+    # Node names come with discovery a little after the subscription itself.
+    assert ros.spin_until(lambda: subscribers() == ["localizer_node"], timeout=5.0), subscribers()
     # Cleaning up releases it.
     rt.system_node.trigger_deactivate()
     rt.system_node.trigger_cleanup()
