@@ -29,6 +29,15 @@ def start_amcl(params_file, runtime_factory):
             "localizer_node.localizer_types": ["amcl"],
             "localizer_node.dummy": None,
             "localizer_node.amcl": AMCL,
+            # AMCL needs the simple map (no perceptions here: corrections only warn).
+            "maps_manager_node.map_types": ["simple"],
+            "maps_manager_node.dummy": None,
+            "maps_manager_node.simple": {
+                "plugin": "easynav_simple_maps_manager/SimpleMapsManager",
+                "freq": 1.0,
+                "package": "easynav_maps",
+                "map_path_file": "worlds/home.map",
+            },
         }
     )
     rt = runtime_factory(params_file(document))
