@@ -127,7 +127,8 @@ def test_a_triggered_run_restarts_the_schedule(ros, params_file, runtime_factory
         lambda: any(not f and t > triggered for t, f in recorder.runs()), timeout=5.0
     )
     following = min(t for t, f in recorder.runs() if not f and t > triggered)
-    assert following - triggered >= period - 0.01, recorder.runs()
+    # (The margin covers a preemption between the recorder's clock read and the schedule's.)
+    assert following - triggered >= period - 0.05, recorder.runs()
 
 
 def test_navstate_is_published_on_easynav_navstate(ros, params_file, runtime_factory):
