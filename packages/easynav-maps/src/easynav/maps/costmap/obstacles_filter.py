@@ -143,8 +143,8 @@ class ObstaclesFilter(CostmapFilter):
             nav_state.set(MAP_TIME, newest)
         if len(marked) == 0:
             return
-        costmap.data.reshape(-1)[marked] = LETHAL_OBSTACLE
         rows, cols = np.divmod(marked, costmap.width)
+        costmap.data[rows, cols] = LETHAL_OBSTACLE  # whatever the array's memory layout
         (x0, x1), (y0, y1) = costmap.cell_to_world(
             np.array([cols.min(), cols.max()]), np.array([rows.min(), rows.max()])
         )
