@@ -22,7 +22,7 @@ Two implementations of the distance transform give identical results (tested):
   knows the radius (column distances capped at radius + 1 cell, then per row either a search
   bounded by the best distance so far or Felzenszwalb's lower envelope of parabolas, skipping
   cells already beyond the radius), fused with the table look-up and the combination with the
-  old costs: one pass over the output. 2-5× faster than the OpenCV path on one core
+  old costs: one pass over the output; 1.5-5× faster than the OpenCV path on one core
   (benchmarks/bench_inflation.py);
 - without: OpenCV's exact transform (``cv2.distanceTransform``, ``DIST_MASK_PRECISE``) and
   numpy for the look-up.
