@@ -308,3 +308,26 @@ def test_a_newer_laser_scan_clears_what_an_older_camera_frame_saw(tmp_path):
     manager.apply_parameter("obstacles.clearing", False)
     manager.update(nav_state)
     assert nav_state.get(MAP).cost_at(2.0, 2.5) == 254
+
+
+def test_bounds_to_window_grows_and_clamps():
+    from easynav.maps.costmap.inflation_filter import bounds_to_window
+
+    grid = Costmap2D.filled(10, 8, 0.5, origin_x=-1.0, origin_y=-1.0)
+    assert bounds_to_window(grid, (0.1, 0.1, 0.6, 0.6), 1) == (1, 1, 5, 5)
+    assert bounds_to_window(grid, (-9.0, -9.0, 99.0, 99.0), 2) == (0, 0, 10, 8)
+    assert bounds_to_window(grid, (50.0, 50.0, 60.0, 60.0), 1) is None
+
+
+def test_inflation_filter_alone_inflates_the_whole_map():
+    from easynav.maps.costmap.inflation_filter import InflationFilter
+
+    inflation = InflationFilter()
+    inflation.initialize(
+        PluginContext(parameters=DictParameters({"i.inflation_radius": 0.5})), "i"
+    )
+    costmap = Costmap2D.filled(20, 20, 0.1)
+    costmap.data[10, 10] = 254
+    expected = inflate(costmap.data, 0.1, 0.5, 0.3, 3.0)
+    inflation.update(NavState(), costmap)  # no map.base: nothing cached, all inflated
+    assert np.array_equal(costmap.data, expected)
