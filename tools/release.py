@@ -192,7 +192,7 @@ def build_folder(folder: Path, out: Path, python: str = sys.executable) -> list[
     result = subprocess.run(
         [python, "-m", "build", "--sdist", "--wheel", "--outdir", str(out), *isolation,
          str(folder)],
-        capture_output=True, text=True,
+        capture_output=True, text=True, env=clean_environment(),
     )
     if result.returncode != 0:
         raise ReleaseError(f"building {folder.name} failed:\n{result.stdout[-3000:]}"
@@ -295,7 +295,7 @@ def isolated(
         version = run([vpy, "--version"]).stdout.strip()
         print(f"[isolated] {', '.join(names)} on {version} ({siblings} siblings): "
               + ", ".join(ours), flush=True)
-        env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+        env = clean_environment()
         # From a copy of the tests outside the repository: nothing but the installed wheels is
         # importable (the repository's conftest gives each test process its ROS domain).
         shutil.copy(ROOT / "conftest.py", work / "conftest.py")
@@ -311,6 +311,16 @@ def isolated(
         ).returncode
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def clean_environment() -> dict[str, str]:
+    """This process's environment without what the ROS wheels' start-up set for *this* venv
+    (its library path and the guard that says it is set): a Python of another venv must set
+    its own, or rclpy there loads this venv's libraries."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("LD_LIBRARY_PATH", "_ROS_WHEELS_BOOTSTRAP_COMPLETE", "VIRTUAL_ENV")}
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    return env
 
 
 def same_python(a: str, b: str) -> bool:
@@ -333,7 +343,7 @@ def build_environment(python: str, work: Path, folder: Path) -> str:
 
 
 def run(cmd: list[str]) -> subprocess.CompletedProcess:
-    result = subprocess.run(cmd, capture_output=True, text=True)
+    result = subprocess.run(cmd, capture_output=True, text=True, env=clean_environment())
     if result.returncode != 0:
         raise ReleaseError(f"{' '.join(cmd)} failed:\n{result.stdout[-3000:]}"
                            f"\n{result.stderr[-3000:]}")

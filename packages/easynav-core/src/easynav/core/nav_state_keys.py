@@ -112,3 +112,10 @@ CONTROL_OWNER = NavStateKey(
 DIAGNOSTICS_PATH = NavStateKey(
     "diagnostics.path", "DiagnosticStatus", "the planner's diagnostic: OK, or WARN saying why."
 )
+
+SPEED_LIMIT = NavStateKey(
+    "speed_limit",
+    "float",
+    "the speed zone's limit at the robot's position, a fraction (0, 1] of the limits in force "
+    "(1.0: no zone); the velocity output cuts the linear and angular limits by it (SpeedFilter).",
+)

@@ -26,6 +26,7 @@ from easynav.core.nav_state_keys import (
     PROPOSAL_OVERRIDE,
     PROPOSAL_TAKEOVER,
     SAFETY_STATUS,
+    SPEED_LIMIT,
 )
 from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.plugin_kinds import CONTROLLER
@@ -231,7 +232,13 @@ class ControllerNode(ComponentNode):
         paused = bool(nav_state.get_or(NAVIGATION_PAUSED, False))
         safety = nav_state.get(SAFETY_STATUS) if nav_state.has(SAFETY_STATUS) else None
         inhibited = bool(nav_state.get_or(MOTION_INHIBITED, False))
-        output.set_limits(self.limits_in_force())
+        # A speed zone (NavState speed_limit, a fraction) cuts the limits the output enforces,
+        # not those controllers see: the zone is the velocity output's, as the safety cut is.
+        zone = nav_state.get_or(SPEED_LIMIT, 1.0)
+        limits = self.limits_in_force()
+        if isinstance(zone, float):
+            limits = limits.scaled(zone)
+        output.set_limits(limits)
         command = output.cycle(now, controller_cmd, takeover, override, paused, safety, inhibited)
         # Proposals last one cycle.
         if takeover is not None:
