@@ -7,15 +7,31 @@ any package is checked once installed, and one whose README has no generated blo
 from __future__ import annotations
 
 import difflib
+import importlib.util
 
-from easynav.core.plugins.readme_tables import COMMAND, documented_plugins, updates
+import pytest
+
+from easynav.core.dummy import DummyController
+from easynav.core.plugins.readme_tables import (
+    COMMAND,
+    distribution_root,
+    documented_plugins,
+    updates,
+)
+
+# Installed from wheels (an isolated install), there is no README to compare with.
+pytestmark = pytest.mark.skipif(
+    distribution_root(DummyController) is None, reason="easynav-core is not a source tree"
+)
 
 
 def test_every_plugin_with_declarations_is_found():
     names = {plugin.name for group, _ in documented_plugins() for plugin in group}
     assert "easynav_controller/DummyController" in names
-    # Other distributions' plugins, when installed (setup installs every package).
-    assert any(name.startswith("easynav_simple_") for name in names)
+    # Other distributions' plugins, when installed (setup installs every package; an isolated
+    # install of the kernel has only its own).
+    if importlib.util.find_spec("easynav.controllers") is not None:
+        assert "easynav_simple_controller/SimpleController" in names
 
 
 def test_readme_tables_match_the_declarations():
