@@ -4,14 +4,8 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-from easynav.core.plugins.declarations import (
-    Param,
-    ParameterValueError,
-    ParameterValues,
-    Topic,
-    merge_declarations,
-    read_parameters,
-)
+from easynav.core.plugins.declarations import Param, ParameterValueError, ParameterValues, Topic
+from easynav.core.plugins.parameter_owner import ParameterOwner
 from easynav.core.plugins.plugin_context import PluginContext
 from easynav.core.plugins.rate_monitor import RateMonitor
 from easynav.core.plugins.rate_schedule import RateSchedule
@@ -29,15 +23,16 @@ COMMON_PARAMETERS = (
 )
 
 
-class MethodBase:
+class MethodBase(ParameterOwner):
     """Base of every plugin.
 
     A plugin declares its parameters once, as data, in ``PARAMETERS`` (see
     :class:`~easynav.core.plugins.declarations.Param`), and reads them as ``self.params.<name>``.
     ``initialize(context, plugin_name)`` declares every parameter on the host node under
     ``<plugin_name>.``, converts and validates it (an error names parameter, value and rule),
-    reads deprecated names with a warning, checks ``rt_freq`` and ``freq`` (10.0 each) against
-    the system cycle's frequencies and calls :meth:`on_initialize`. It may be called again on the
+    reads deprecated names with a warning, checks ``rt_freq`` and ``freq`` (10.0 each) of the
+    parts the plugin has (:meth:`used_frequencies`) against the system cycle's frequencies and
+    calls :meth:`on_initialize`. It may be called again on the
     same object or on a fresh one after a cleanup (runtime reconfiguration).
 
     Thread contract: ``initialize`` runs in the configuring thread while no loop runs; RT methods
@@ -53,6 +48,7 @@ class MethodBase:
     #: The plugin's own parameters (see :class:`Param`); a subclass's replace its bases' of the
     #: same name. ``rt_freq`` and ``freq`` are common to every plugin.
     PARAMETERS: ClassVar[tuple[Param, ...]] = ()
+    BASE_PARAMETERS: ClassVar[tuple[Param, ...]] = COMMON_PARAMETERS
     #: Topics the plugin publishes or subscribes to on its host node.
     TOPICS: ClassVar[tuple[Topic, ...]] = ()
     #: NavState keys the plugin reads and writes (NavStateKey constants).
@@ -75,57 +71,32 @@ class MethodBase:
         self.rate_monitor: RateMonitor | None = None
         self.params = ParameterValues()
 
-    # -- declarations --------------------------------------------------------------------------
-    @classmethod
-    def parameter_declarations(cls) -> tuple[Param, ...]:
-        """Every parameter of this plugin class: the common ones, then each class's own
-        (base classes first; a subclass's declaration replaces a base's of the same name)."""
-        groups = [COMMON_PARAMETERS]
-        for klass in reversed(cls.__mro__):
-            own = klass.__dict__.get("PARAMETERS")
-            if own:
-                groups.append(own)
-        return merge_declarations(groups)
-
-    @classmethod
-    def parameter_declaration(cls, name: str) -> Param | None:
-        """The declaration of ``name`` (current or deprecated name), or None."""
-        for param in cls.parameter_declarations():
-            if name == param.name or name in param.deprecated:
-                return param
-        return None
-
+    # -- declarations (see ParameterOwner) ----------------------------------------------------
     def validate_parameter(self, name: str, value: Any) -> Any:
-        """A runtime change of ``<alias>.<name>`` checked against its declaration: the converted
-        value, or :class:`ParameterValueError` with the reason (the host refuses the change)."""
+        """A runtime change of ``<alias>.<name>`` checked against its declaration (and, for
+        ``rt_freq``/``freq``, against the system cycle): the converted value, or
+        :class:`ParameterValueError` with the reason (the host refuses the change)."""
+        converted = super().validate_parameter(name, value)
         param = self.parameter_declaration(name)
-        full = f"{self.plugin_name}.{name}"
-        if param is None:
-            raise ParameterValueError(f"{full}: unknown parameter")
-        if not param.dynamic:
-            raise ParameterValueError(f"{full}: cannot change at runtime (reconfigure instead)")
-        converted = param.convert(value, full)
-        if param.name in ("rt_freq", "freq"):
-            self._check_frequency(param.name, converted)
+        if param is not None and param.name in ("rt_freq", "freq"):
+            try:
+                self._check_frequency(param.name, converted)
+            except PluginConfigurationError as exc:
+                raise ParameterValueError(str(exc)) from None
         return converted
 
     def apply_parameter(self, name: str, value: Any) -> None:
-        """Store a validated runtime change and tell the plugin (:meth:`on_parameter_changed`)."""
+        """Store a validated runtime change (a new frequency restarts its schedule) and tell the
+        plugin (:meth:`on_parameter_changed`)."""
         param = self.parameter_declaration(name)
         key = param.name if param is not None else name
-        self.params.set(key, value)
         if key == "rt_freq":
             self.rt_freq = value
             self.rt_schedule = RateSchedule(value)
         elif key == "freq":
             self.freq = value
             self.schedule = RateSchedule(value)
-        self.on_parameter_changed(key, value)
-
-    def on_parameter_changed(self, name: str, value: Any) -> None:
-        """A parameter changed at runtime (already validated and stored in ``self.params``).
-        Plugins that read ``self.params`` every cycle need nothing here; those that derive
-        state from a parameter rebuild it."""
+        super().apply_parameter(name, value)
 
     # -- lifecycle ---------------------------------------------------------------------------
     def initialize(self, context: PluginContext, plugin_name: str) -> None:
@@ -133,14 +104,17 @@ class MethodBase:
         self.context = context
         self.plugin_name = plugin_name
         try:
-            self.params = read_parameters(
-                self.parameter_declarations(), context.parameters, plugin_name,
-                warn=lambda message: self.logger.warning(message),
+            self.read_declared_parameters(
+                context.parameters, plugin_name, warn=lambda message: self.logger.warning(message)
             )
         except ParameterValueError as exc:
             raise PluginConfigurationError(str(exc)) from None
         self.rt_freq = self._check_frequency("rt_freq", self.params.rt_freq)
         self.freq = self._check_frequency("freq", self.params.freq)
+        in_use = context.frequencies_in_use
+        if in_use is not None:
+            for name in self.used_frequencies():
+                in_use.add((context.node_name, f"{plugin_name}.{name}"))
         self.rt_schedule = RateSchedule(self.rt_freq)
         self.schedule = RateSchedule(self.freq)
         self.on_initialize()
@@ -151,14 +125,31 @@ class MethodBase:
     def on_cleanup(self) -> None:
         """Release what ``on_initialize`` created (called on cleanup)."""
 
+    def cleanup(self) -> None:
+        """What hosts call on cleanup: :meth:`on_cleanup`, then what a base class created in
+        ``initialize`` (e.g. a localizer's ``initialpose`` subscription). Configuring thread."""
+        self.on_cleanup()
+
     def on_activate(self) -> None:
         """EasyNav becomes active (its cycles start). Lifecycle thread, loops not cycling."""
 
     def on_deactivate(self) -> None:
         """EasyNav becomes inactive (its cycles stop). Lifecycle thread, loops not cycling."""
 
+    @classmethod
+    def used_frequencies(cls) -> tuple[str, ...]:
+        """The frequency parameters this plugin runs at: ``rt_freq`` with an RT part, ``freq``
+        with a non-RT part. The others are declared (common to every plugin) but unused."""
+        return (("rt_freq",) if cls.HAS_RT_UPDATE else ()) + (
+            ("freq",) if cls.HAS_UPDATE else ()
+        )
+
     def _check_frequency(self, name: str, value: float) -> float:
-        # A plugin cannot run faster than the cycle that schedules it.
+        # A plugin cannot run faster than the cycle that schedules it; a frequency of a part the
+        # plugin does not have schedules nothing (e.g. a planner's rt_freq default of 10 Hz
+        # under a 5 Hz RT cycle) and is not an error.
+        if name not in self.used_frequencies():
+            return value
         system_value, system_name = (
             (self.context.system_rt_freq, "system_node.rt_freq") if name == "rt_freq"
             else (self.context.system_freq, "system_node.freq")
@@ -173,7 +164,9 @@ class MethodBase:
 
     # -- helpers for plugins ----------------------------------------------------------------
     def get_parameter(self, name: str, default: Any, description: str = "") -> Any:
-        """Declare-if-absent ``<plugin_name>.<name>`` on the host node and return its value."""
+        """Declare-if-absent ``<plugin_name>.<name>`` on the host node and return its value,
+        unchecked. Only for keys a host reads for its sub-plugins (``<sub_alias>.plugin``):
+        a plugin's own parameters are declared in ``PARAMETERS`` and read as ``self.params``."""
         return self.context.parameters.declare(f"{self.plugin_name}.{name}", default, description)
 
     def get_robot_geometry(self) -> RobotGeometry:

@@ -9,7 +9,6 @@ import numpy as np
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
-from easynav.core.robot import RobotGeometry
 from easynav.core.types import Costmap2D
 from easynav.maps.costmap.costmap_filter import CostmapFilter
 from easynav.maps.costmap.keys import MAP_BASE, MAP_OBSTACLE_BOUNDS
@@ -47,7 +46,8 @@ class InflationFilter(CostmapFilter):
 
     The inscribed radius is ``system_node.robot_geometry.inscribed_radius``. The filter's own
     ``inscribed_radius`` (the original's, 0.25) is deprecated: set, it applies (with a warning)
-    only while robot_geometry keeps its default; robot_geometry takes precedence otherwise.
+    only where the params file sets neither ``robot_geometry.inscribed_radius`` nor the
+    ``robot_geometry.radius`` it defaults to; robot_geometry takes precedence otherwise.
 
     ``map.base`` is inflated once and cached (again when its size, resolution, origin or stamp,
     or a parameter, change); each cycle the working map is inflated only inside
@@ -74,6 +74,8 @@ class InflationFilter(CostmapFilter):
         self._signature: tuple | None = None
         self._base_raw: np.ndarray | None = None
         self._inscribed_warning: str | None = None
+        self._table_key: tuple | None = None
+        self._table: np.ndarray | None = None
 
     def on_initialize(self) -> None:
         self._signature = None
@@ -96,7 +98,9 @@ class InflationFilter(CostmapFilter):
         if math.isnan(legacy):
             return geometry.inscribed_radius
         name = f"{self.plugin_name}.inscribed_radius"
-        if geometry.inscribed_radius != RobotGeometry().inscribed_radius:
+        # robot_geometry configures the inscribed radius when the params file sets it, or sets
+        # the radius it defaults to (seed-design: it takes precedence, whatever its value).
+        if geometry.is_set("inscribed_radius") or geometry.is_set("radius"):
             message = (
                 f"{name} is deprecated and ignored: system_node.robot_geometry.inscribed_radius "
                 f"= {geometry.inscribed_radius:g} takes precedence"
@@ -114,12 +118,14 @@ class InflationFilter(CostmapFilter):
         return value
 
     def settings(self, resolution: float) -> tuple[int, np.ndarray]:
-        """``(cell radius, cost table by squared cell distance)`` for ``resolution``."""
+        """``(cell radius, cost table by squared cell distance)`` for ``resolution`` (the table
+        is rebuilt only when an input changes: a large radius makes it thousands of entries)."""
         cell_radius = cell_inflation_radius(self.params.inflation_radius, resolution)
-        table = inflation_cost_table(
-            cell_radius, resolution, self.inscribed_radius(), self.params.cost_scaling_factor
-        )
-        return cell_radius, table
+        key = (cell_radius, resolution, self.inscribed_radius(), self.params.cost_scaling_factor)
+        if key != self._table_key or self._table is None:
+            self._table = inflation_cost_table(*key)
+            self._table_key = key
+        return cell_radius, self._table
 
     def update(self, nav_state: NavState, costmap: Costmap2D) -> None:
         """Inflate ``costmap`` in place. Non-RT thread."""
