@@ -1,0 +1,82 @@
+"""GridMapRRTStarPlanner (easynav_gridmap_rrtstar_planner/GridMapRRTStarPlanner)."""
+
+from __future__ import annotations
+
+import math
+
+from easynav.core.plugins import Param
+from easynav.maps.gridmap import GridMap
+from easynav.planners.gridmap.gridmap_planner_base import GridMapPlannerBase, yaws_along
+from easynav.planners.gridmap.terrain import cell_cost_factors
+from easynav.planners.gridmap.terrain_astar import dijkstra_costs
+from easynav.planners.gridmap.terrain_rrtstar import (
+    RRTStarSettings,
+    TerrainSegments,
+    resample,
+    rrt_star,
+    shortcut,
+)
+from easynav.planners.plan_result import PlanResult
+
+
+class GridMapRRTStarPlanner(GridMapPlannerBase):
+    """RRT* over the elevation map, never on or across a slope above the limit; seeded.
+
+    Parameters: :attr:`PARAMETERS`. Segments obey the slope rules of
+    :mod:`~easynav.planners.gridmap.terrain_rrtstar`; cells within the robot's radius
+    (``system_node.robot_geometry.radius``) of steep terrain cost more. Before sampling, the goal
+    is checked to be reachable at all (a Dijkstra flood over the same rules), so an unreachable
+    goal is reported at once, not after ``max_iters``. The tree's path is shortened (each
+    shortcut no dearer and within ``max_lateral_deviation`` of the points it drops), resampled
+    every ``spacing`` m; the last ``final_poses_with_goal_orientation`` poses take the goal yaw.
+    ``kdtree_rebuild_interval`` is accepted for the original's files: nearest neighbours are
+    found here by an exact vectorised scan, which needs no tree. The same map, start, goal and
+    ``seed`` give the same path. NavState and threads: :class:`GridMapPlannerBase`.
+    """
+
+    PARAMETERS = (
+        Param("max_allowed_slope_deg", 40.0, "steepest slope the robot may drive", "deg",
+              gt=0.0, lt=90.0),
+        Param("max_iters", 3000, "samples drawn per plan", ge=1),
+        Param("step_size", 1.0, "longest new tree edge", "m", gt=0.0),
+        Param("neighbor_radius", 2.0, "radius of parent choice and rewiring", "m", gt=0.0),
+        Param("goal_bias", 0.15, "probability of sampling the goal", ge=0.0, le=1.0),
+        Param("goal_threshold", 0.5, "a node this close to the goal may end the path", "m",
+              gt=0.0),
+        Param("kdtree_rebuild_interval", 800,
+              "accepted for the original's files (exact scan here, no k-d tree)", ge=1),
+        Param("spacing", 0.2, "distance between poses of the output path", "m", gt=0.0),
+        Param("max_lateral_deviation", 0.5,
+              "farthest a shortcut may pass from the tree points it drops", "m", ge=0.0),
+        Param("final_poses_with_goal_orientation", 2, "last poses given the goal's yaw", ge=1),
+        Param("seed", 0, "seed of the sampler (same seed, same path)"),
+    )
+
+    def plan(self, grid: GridMap, start: tuple[float, float],
+             goal: tuple[float, float, float]) -> PlanResult:
+        """RRT* from ``start`` to ``goal`` on ``grid`` (reads the parameters now)."""
+        p = self.params
+        max_slope = math.radians(p.max_allowed_slope_deg)
+        margin = self.get_robot_geometry().radius
+        factors = cell_cost_factors(grid, max_slope, margin)
+        sx, sy = (int(v) for v in grid.world_to_cell(*start))
+        gx, gy = (int(v) for v in grid.world_to_cell(goal[0], goal[1]))
+        if math.isinf(factors[gy, gx]):
+            return PlanResult(reason=f"the goal is on terrain steeper than "
+                                     f"{p.max_allowed_slope_deg:g} deg or unknown")
+        if math.isinf(dijkstra_costs(grid, (sx, sy), max_slope, margin)[gy, gx]):
+            return PlanResult(reason=f"unreachable without slopes above "
+                                     f"{p.max_allowed_slope_deg:g} deg")
+        settings = RRTStarSettings(
+            max_iters=p.max_iters, step_size=p.step_size, neighbor_radius=p.neighbor_radius,
+            goal_bias=p.goal_bias, goal_threshold=p.goal_threshold,
+            max_lateral_deviation=p.max_lateral_deviation, seed=p.seed,
+        )
+        segments = TerrainSegments(grid, factors, max_slope)
+        found = rrt_star(segments, start, goal[:2], settings)
+        if found is None:
+            return PlanResult(reason=f"RRT* found no path in {p.max_iters} iterations "
+                                     f"(the goal is reachable: raise max_iters)")
+        path = shortcut(segments, found[0], p.max_lateral_deviation)
+        points = resample(path, p.spacing)
+        return PlanResult(yaws_along(points, goal[2], p.final_poses_with_goal_orientation))

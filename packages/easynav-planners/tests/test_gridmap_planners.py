@@ -1,0 +1,220 @@
+"""GridMap A* and RRT* without ROS: optimality, the slope rule, unreachable goals, determinism."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import DictParameters, PluginContext
+from easynav.core.types import (
+    DiagnosticLevel,
+    DiagnosticStatus,
+    Goals,
+    Header,
+    Odometry,
+    Path,
+    Pose,
+    PoseStamped,
+)
+from easynav.maps.gridmap import GridMap
+from easynav.planners.gridmap.gridmap_astar_planner import GridMapAStarPlanner
+from easynav.planners.gridmap.gridmap_rrtstar_planner import GridMapRRTStarPlanner
+from easynav.planners.gridmap.terrain import cell_cost_factors, slope_of_move, steep_cells
+from easynav.planners.gridmap.terrain_astar import astar, dijkstra_costs
+
+_namespaces = itertools.count()
+LIMIT_DEG = 30.0
+
+
+def random_terrain(seed: int, size: int = 14, resolution: float = 0.1) -> GridMap:
+    """Rough terrain: smoothed noise, steep enough that the rule cuts many moves."""
+    rng = np.random.default_rng(seed)
+    z = rng.normal(scale=0.08, size=(size, size))
+    z = (z + np.roll(z, 1, 0) + np.roll(z, 1, 1)) / 2.0
+    return GridMap.from_elevation(z, resolution, max_slope_rad=math.radians(LIMIT_DEG))
+
+
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize("margin", [0.0, 0.15])
+def test_astar_cost_equals_dijkstra_on_random_terrain(seed, margin):
+    grid = random_terrain(seed)
+    limit = math.radians(LIMIT_DEG)
+    rng = np.random.default_rng(100 + seed)
+    h, w = grid.shape
+    start = (int(rng.integers(w)), int(rng.integers(h)))
+    reference = dijkstra_costs(grid, start, limit, margin)
+    reachable = 0
+    for _ in range(8):
+        goal = (int(rng.integers(w)), int(rng.integers(h)))
+        found = astar(grid, start, goal, limit, margin)
+        if math.isinf(reference[goal[1], goal[0]]):
+            assert found is None
+            continue
+        reachable += 1
+        cells, cost = found
+        assert cost == pytest.approx(reference[goal[1], goal[0]], rel=1e-12, abs=1e-12)
+        assert cells[0] == start and cells[-1] == goal
+        assert_cells_obey_the_rule(grid, cells, limit)
+    assert 0 < np.isinf(reference).sum() < reference.size  # the rule did cut something
+
+
+def assert_cells_obey_the_rule(grid, cells, limit):
+    steep = steep_cells(grid, limit)
+    z = grid.elevation
+    for a, b in itertools.pairwise(cells):
+        assert not steep[b[1], b[0]]
+        assert max(abs(a[0] - b[0]), abs(a[1] - b[1])) == 1
+        horizontal = grid.resolution * math.hypot(b[0] - a[0], b[1] - a[1])
+        assert slope_of_move(z[a[1], a[0]], z[b[1], b[0]], horizontal) <= limit + 1e-9
+
+
+def assert_path_obeys_the_rule(grid: GridMap, path: Path, limit: float) -> None:
+    """Every cell a path crosses (sampled every 1/8 cell) and every step between them."""
+    points = np.array([(p.x, p.y) for p in path.poses])
+    steep = steep_cells(grid, limit)
+    z = grid.elevation
+    for a, b in itertools.pairwise(points):
+        n = max(1, math.ceil(math.hypot(*(b - a)) / (grid.resolution / 8)))
+        t = np.linspace(0, 1, n + 1)[:, None]
+        ix, iy = grid.world_to_cell(*(a + t * (b - a)).T)
+        cells = [c for i, c in enumerate(zip(ix, iy, strict=True))
+                 if i == 0 or c != (ix[i - 1], iy[i - 1])]
+        for c0, c1 in itertools.pairwise(cells):
+            assert not steep[c1[1], c1[0]], f"steep cell {c1} used"
+            horizontal = grid.resolution * math.hypot(c1[0] - c0[0], c1[1] - c0[1])
+            slope = slope_of_move(z[c0[1], c0[0]], z[c1[1], c1[0]], horizontal)
+            assert slope <= limit + 1e-9, f"move {c0}->{c1} at {math.degrees(slope):.1f} deg"
+
+
+def ridge_world(gap: bool = True) -> GridMap:
+    """8 m x 6 m, flat, split at x = 4 m by a 1 m wall (near-vertical sides); a 1 m gap at
+    y 4..5 when ``gap``; a 35 deg cone hill (above the 30 deg limit) on the direct line."""
+    resolution = 0.1
+    xs = (np.arange(80) + 0.5) * resolution
+    ys = (np.arange(60) + 0.5) * resolution
+    x, y = np.meshgrid(xs, ys)
+    z = np.zeros_like(x)
+    z[(x > 3.8) & (x < 4.2)] = 1.0
+    if gap:
+        z[(x > 3.7) & (x < 4.3) & (y > 4.0) & (y < 5.0)] = 0.0
+    r = np.hypot(x - 2.0, y - 2.0)
+    z += np.clip(math.tan(math.radians(35)) * (0.8 - r), 0.0, None)
+    return GridMap.from_elevation(z, resolution)
+
+
+def make_planner(cls, params=None):
+    planner = cls()
+    planner.initialize(
+        PluginContext(
+            parameters=DictParameters({f"p.{k}": v for k, v in (params or {}).items()}),
+            namespace=f"gridmap_planner_test_{next(_namespaces)}",
+            now=lambda: 2.0,
+        ),
+        "p",
+    )
+    return planner
+
+
+def state_with(grid, start, goal) -> NavState:
+    nav_state = NavState()
+    nav_state.set("map", grid)
+    nav_state.set("robot_pose",
+                  Odometry(Header(1.0, "map"), "base_footprint", Pose.from_xy_yaw(*start, 0.0)))
+    pose = PoseStamped(Header(1.0, "map"), Pose.from_xy_yaw(*goal))
+    nav_state.set("goals", Goals(Header(1.0, "map"), [pose]))
+    return nav_state
+
+
+PLANNERS = [
+    (GridMapAStarPlanner, {"max_allowed_slope_deg": LIMIT_DEG}),
+    (GridMapRRTStarPlanner, {"max_allowed_slope_deg": LIMIT_DEG, "seed": 3}),
+]
+
+
+@pytest.mark.parametrize(("cls", "params"), PLANNERS)
+def test_planners_go_round_the_steep_hill_and_through_the_gap(cls, params):
+    grid = ridge_world()
+    planner = make_planner(cls, params)
+    nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.5))
+    planner.update(nav_state)
+    path = nav_state.get("path", Path)
+    assert len(path) > 1
+    assert_path_obeys_the_rule(grid, path, math.radians(LIMIT_DEG))
+    ys_at_wall = [p.y for p in path.poses if 3.7 < p.x < 4.3]
+    assert ys_at_wall and all(4.0 < yy < 5.0 for yy in ys_at_wall)
+    assert (path.poses[-1].x, path.poses[-1].y) == pytest.approx((7.0, 1.0))
+    assert path.poses[-1].yaw == pytest.approx(0.5)
+    status = nav_state.get("diagnostics.path", DiagnosticStatus)
+    assert status.level == DiagnosticLevel.OK
+
+
+@pytest.mark.parametrize(("cls", "params"), PLANNERS)
+def test_a_slope_just_above_the_limit_is_never_climbed(cls, params):
+    """A plateau reached only by a 31 deg ramp: unreachable at 30 deg, reachable at 32."""
+    resolution = 0.1
+    x = (np.arange(60) + 0.5) * resolution
+    profile = np.clip(math.tan(math.radians(31)) * (x - 2.0), 0.0, 1.0)
+    grid = GridMap.from_elevation(np.tile(profile, (20, 1)), resolution)
+    nav_state = state_with(grid, (0.5, 1.0), (5.5, 1.0, 0.0))
+    make_planner(cls, params).update(nav_state)
+    assert len(nav_state.get("path", Path)) == 0
+    status = nav_state.get("diagnostics.path", DiagnosticStatus)
+    assert status.level == DiagnosticLevel.WARN and "unreachable" in status.message
+    steeper = dict(params, max_allowed_slope_deg=32.0)
+    make_planner(cls, steeper).update(nav_state)
+    path = nav_state.get("path", Path)
+    assert len(path) > 1
+    assert_path_obeys_the_rule(grid, path, math.radians(32.0))
+
+
+@pytest.mark.parametrize(("cls", "params"), PLANNERS)
+def test_unreachable_goal_gives_an_empty_path_and_a_warning(cls, params):
+    nav_state = state_with(ridge_world(gap=False), (1.0, 1.0), (7.0, 1.0, 0.0))
+    make_planner(cls, params).update(nav_state)
+    assert len(nav_state.get("path", Path)) == 0
+    status = nav_state.get("diagnostics.path", DiagnosticStatus)
+    assert status.level == DiagnosticLevel.WARN
+    assert "goal (7.00, 1.00)" in status.message and "unreachable" in status.message
+
+
+@pytest.mark.parametrize(("cls", "params"), PLANNERS)
+def test_goal_off_the_map_or_on_the_hill_is_named(cls, params):
+    planner = make_planner(cls, params)
+    nav_state = state_with(ridge_world(), (1.0, 1.0), (9.0, 1.0, 0.0))
+    planner.update(nav_state)
+    assert "off the gridmap" in nav_state.get("diagnostics.path", DiagnosticStatus).message
+    nav_state = state_with(ridge_world(), (1.0, 1.0), (2.3, 2.3, 0.0))
+    planner.update(nav_state)
+    assert "steeper than 30 deg" in nav_state.get("diagnostics.path", DiagnosticStatus).message
+
+
+def test_rrtstar_is_deterministic_for_a_seed():
+    grid = ridge_world()
+    paths = []
+    for _ in range(2):
+        nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.0))
+        make_planner(GridMapRRTStarPlanner, {"seed": 11, "max_iters": 1500}).update(nav_state)
+        paths.append([(p.x, p.y, p.yaw) for p in nav_state.get("path", Path).poses])
+    assert paths[0] and paths[0] == paths[1]
+
+
+def test_rrtstar_output_spacing_and_goal_orientation():
+    nav_state = state_with(ridge_world(), (1.0, 5.5), (7.0, 5.5, 1.0))
+    make_planner(GridMapRRTStarPlanner, {"spacing": 0.3, "final_poses_with_goal_orientation": 3,
+                                         "max_iters": 1500}).update(nav_state)
+    poses = nav_state.get("path", Path).poses
+    gaps = np.hypot(np.diff([p.x for p in poses]), np.diff([p.y for p in poses]))
+    assert gaps.max() <= 0.3 + 1e-9
+    assert [p.yaw for p in poses[-3:]] == pytest.approx([1.0] * 3)
+
+
+def test_margin_cells_cost_more_and_steep_cells_are_infinite():
+    grid = ridge_world()
+    factors = cell_cost_factors(grid, math.radians(LIMIT_DEG), 0.3)
+    steep = steep_cells(grid, math.radians(LIMIT_DEG))
+    assert np.isinf(factors[steep]).all() and np.isfinite(factors[~steep]).all()
+    assert (factors[~steep] > 1).any()
