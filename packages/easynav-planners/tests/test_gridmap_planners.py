@@ -218,3 +218,26 @@ def test_margin_cells_cost_more_and_steep_cells_are_infinite():
     steep = steep_cells(grid, math.radians(LIMIT_DEG))
     assert np.isinf(factors[steep]).all() and np.isfinite(factors[~steep]).all()
     assert (factors[~steep] > 1).any()
+
+
+@pytest.mark.parametrize(("cls", "params"), PLANNERS)
+def test_shipped_uneven_world_plateau_only_by_the_ramp(cls, params):
+    """easynav_maps' worlds/uneven_terrain.yaml (the original's format): the plateau (0.8 m)
+    has 60 deg cliffs and one 15 deg ramp at y 1..3 m."""
+    from easynav.maps import resolve_map_file
+    from easynav.maps.gridmap import load_gridmap
+
+    grid = load_gridmap(resolve_map_file("easynav_maps", "worlds/uneven_terrain.yaml"))
+    nav_state = state_with(grid, (1.0, 6.5), (10.0, 6.0, 0.0))
+    make_planner(cls, params).update(nav_state)
+    path = nav_state.get("path", Path)
+    assert len(path) > 1, nav_state.get("diagnostics.path", DiagnosticStatus).message
+    assert_path_obeys_the_rule(grid, path, math.radians(LIMIT_DEG))
+    climb = [p.y for p in path.poses if 5.0 < p.x < 7.4]
+    z = grid.elevation
+    ix, iy = grid.world_to_cell(np.array([p.x for p in path.poses]),
+                                np.array([p.y for p in path.poses]))
+    on_slope = (z[iy, ix] > 0.05) & (z[iy, ix] < 0.75)
+    assert on_slope.any() and climb
+    ys = np.array([p.y for p in path.poses])[on_slope]
+    assert ((ys > 1.0) & (ys < 3.0)).all()  # climbed on the ramp only
