@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path as FilePath
 
 import numpy as np
 import pytest
@@ -217,3 +218,29 @@ def test_declarations_list_the_parameters_topics_and_keys():
     assert {"state_space", "planner", "turning_radius", "solve_time", "seed", "freq"} <= names
     assert [str(k) for k in OMPLPlanner.READS] == ["goals", "robot_pose", "map", "map.base"]
     assert [str(k) for k in OMPLPlanner.WRITES] == ["path", "diagnostics.path"]
+
+
+@pytest.mark.parametrize(
+    ("name", "space"), [("ompl.params.yaml", "SE2"), ("ompl.reeds_shepp.params.yaml", "ReedsShepp")]
+)
+def test_the_shipped_params_files_configure_the_plugin(name, space):
+    import yaml
+
+    from easynav.core.plugins.discovery import load_plugin_class
+    from easynav.core.plugins.plugin_kinds import PLANNER
+
+    path = FilePath(__file__).resolve().parents[3] / "params" / name
+    section = yaml.safe_load(path.read_text())["planner_node"]["ros__parameters"]
+    (alias,) = section["planner_types"]
+    settings = {k: v for k, v in section[alias].items() if k != "plugin"}
+    assert section[alias]["plugin"] == "easynav_ompl_planner/OMPLPlanner"
+    context = PluginContext(
+        parameters=DictParameters({f"{alias}.{k}": v for k, v in settings.items()}),
+        namespace=f"ompl_test_{next(_namespaces)}",
+        now=lambda: 7.0,
+    )
+    plugin_class = load_plugin_class(PLANNER, section[alias]["plugin"], "plugin")
+    assert plugin_class is OMPLPlanner  # the entry point is installed
+    planner = OMPLPlanner()
+    planner.initialize(context, alias)
+    assert planner.planner.state_space == space and planner.planner.planner == "RRTConnect"

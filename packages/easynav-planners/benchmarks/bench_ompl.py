@@ -1,0 +1,165 @@
+"""OMPL RRTConnect and RRT* (1 s budget) beside the grid A* on the same warehouse queries.
+
+    .venv/bin/python packages/easynav-planners/benchmarks/bench_ompl.py [--full] [--json PATH]
+
+The map is the warehouse (/work/shared/maps/warehouse.yaml, 30 m x 50 m at 0.03 m; unknown
+cells count as obstacles). Queries: random start/goal pairs at least 8 m apart, both clear of
+obstacles by the robot radius (0.3 m) + clearance (0.1 m) for both planners, drawn with a fixed
+seed; 10 by default, 50 with ``--full`` (about a minute per 50 RRT* queries). Reference: the
+grid A* of SimplePlanner (``SimpleGridPlanner``: 8-connected A* at 0.2 m with the same radius and
+clearance, line-of-sight smoothing), measured in the same run on the same queries.
+
+Figures per OMPL planner: success rate (a path found and verified), planning time (median and
+p99 over the queries), path length ratio OMPL / A* (median over the queries both solved).
+``--json PATH`` writes the rows ``{figure, value, unit, reference, reference_value, ratio, goal,
+met}``. Nothing is asserted: goals are reported as met or not.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from easynav.core.types import LETHAL_OBSTACLE, NO_INFORMATION, Costmap2D
+from easynav.maps import SimpleMap
+from easynav.maps.map_yaml import load_map_yaml
+from easynav.planners import SimpleGridPlanner
+from easynav.planners.ompl_grid_planner import OMPLGridPlanner
+
+WAREHOUSE = Path("/work/shared/maps/warehouse.yaml")
+ROBOT_RADIUS = 0.3
+CLEARANCE = 0.1
+BUDGET = 1.0
+MIN_DISTANCE = 8.0
+
+
+def load_maps(path: Path) -> tuple[Costmap2D, SimpleMap]:
+    """The map-server map as a Costmap2D (occupied lethal, unknown 255) and a SimpleMap
+    (occupied or unknown = occupied)."""
+    grid = load_map_yaml(path)
+    data = np.zeros(grid.data.shape, dtype=np.uint8)
+    data[grid.data >= 65] = LETHAL_OBSTACLE
+    data[grid.data < 0] = NO_INFORMATION
+    costmap = Costmap2D(data, grid.resolution, grid.origin.x, grid.origin.y)
+    blocked = data >= LETHAL_OBSTACLE
+    world = SimpleMap(grid.width, grid.height, grid.resolution, grid.origin.x, grid.origin.y,
+                      blocked)
+    return costmap, world
+
+
+def draw_queries(costmap, world, astar, checker, count, seed=2026):
+    """``count`` (start, goal) pairs clear for both planners, at least MIN_DISTANCE apart."""
+    rng = np.random.default_rng(seed)
+    coarse = astar.coarse_map(world)
+    levels = astar.danger_levels(coarse)
+    x0, y0, x1, y1 = costmap.extent()
+
+    def clear(x, y):
+        ix, iy = coarse.world_to_cell(x, y)
+        return (
+            checker.is_free(x, y)
+            and 0 <= ix < coarse.width and 0 <= iy < coarse.height
+            and levels[int(iy), int(ix)] == 0
+        )
+
+    queries = []
+    while len(queries) < count:
+        a = rng.uniform((x0, y0), (x1, y1))
+        b = rng.uniform((x0, y0), (x1, y1))
+        if math.dist(a, b) < MIN_DISTANCE or not (clear(*a) and clear(*b)):
+            continue
+        yaw_a, yaw_b = rng.uniform(-math.pi, math.pi, 2)
+        queries.append(((a[0], a[1], yaw_a), (b[0], b[1], yaw_b)))
+    return queries
+
+
+def percentile(values, q):
+    values = sorted(values)
+    return values[min(len(values) - 1, int(q * (len(values) - 1) + 0.5))] if values else math.nan
+
+
+def run(label, plan, queries):
+    """``(times, lengths)``: seconds per query, path length (NaN when no path)."""
+    times, lengths = [], []
+    for i, (start, goal) in enumerate(queries):
+        began = time.perf_counter()
+        result = plan(start, goal)
+        times.append(time.perf_counter() - began)
+        lengths.append(result.length if result.ok else math.nan)
+        print(f"\r{label:>12}: query {i + 1}/{len(queries)}", end="", file=sys.stderr)
+    print(file=sys.stderr)
+    return times, lengths
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--full", action="store_true", help="the 50 queries (default 10)")
+    parser.add_argument("--queries", type=int, default=None, help="number of queries")
+    parser.add_argument("--json", type=Path, default=None, help="write the rows here")
+    parser.add_argument("--map", type=Path, default=WAREHOUSE)
+    args = parser.parse_args()
+    count = args.queries or (50 if args.full else 10)
+
+    costmap, world = load_maps(args.map)
+    astar = SimpleGridPlanner(ROBOT_RADIUS, CLEARANCE)
+    planners = {
+        "RRTConnect": OMPLGridPlanner(planner="RRTConnect", solve_time=BUDGET, seed=1,
+                                      robot_radius=ROBOT_RADIUS, clearance_distance=CLEARANCE),
+        "RRTstar": OMPLGridPlanner(planner="RRTstar", solve_time=BUDGET, seed=1,
+                                   robot_radius=ROBOT_RADIUS, clearance_distance=CLEARANCE),
+    }
+    checker = planners["RRTConnect"]._checkers(costmap)[1]  # the stricter (planning) test
+    queries = draw_queries(costmap, world, astar, checker, count)
+    print(f"warehouse {costmap.width}x{costmap.height} cells at {costmap.resolution} m, "
+          f"{count} queries >= {MIN_DISTANCE} m apart, budget {BUDGET} s")
+
+    a_times, a_lengths = run("A* (grid)", lambda s, g: astar.plan(world, s[:2], g), queries)
+    a_ok = [not math.isnan(v) for v in a_lengths]
+    rows = []
+    print(f"{'planner':>12} | {'success':>7} | {'time p50':>9} {'p99':>8} | {'length / A*':>11}")
+    print(f"{'A* (grid)':>12} | {sum(a_ok) / count:>7.0%} | {statistics.median(a_times):>7.3f} s "
+          f"{percentile(a_times, 0.99):>6.3f} s | {1.0:>11.2f}")
+    for name, planner in planners.items():
+        times, lengths = run(name, lambda s, g, p=planner: p.plan(costmap, s, g), queries)
+        ok = [not math.isnan(v) for v in lengths]
+        ratios = [lengths[i] / a_lengths[i] for i in range(count) if ok[i] and a_ok[i]]
+        success = sum(ok) / count
+        ratio = statistics.median(ratios) if ratios else math.nan
+        print(f"{name:>12} | {success:>7.0%} | {statistics.median(times):>7.3f} s "
+              f"{percentile(times, 0.99):>6.3f} s | {ratio:>11.2f}")
+        a_success = sum(a_ok) / count
+        rows += [
+            {"figure": f"{name} success rate", "value": success, "unit": "fraction",
+             "reference": "grid A* success rate", "reference_value": a_success,
+             "ratio": success / a_success if a_success else math.nan,
+             "goal": ">= A*'s", "met": success >= a_success},
+            {"figure": f"{name} planning time p50", "value": statistics.median(times),
+             "unit": "s", "reference": "grid A* time p50",
+             "reference_value": statistics.median(a_times),
+             "ratio": statistics.median(times) / statistics.median(a_times),
+             "goal": f"<= {BUDGET} s budget",
+             "met": statistics.median(times) <= BUDGET + 0.2},
+            {"figure": f"{name} planning time p99", "value": percentile(times, 0.99),
+             "unit": "s", "reference": "grid A* time p99",
+             "reference_value": percentile(a_times, 0.99),
+             "ratio": percentile(times, 0.99) / percentile(a_times, 0.99),
+             "goal": f"<= {BUDGET} s budget + simplification",
+             "met": percentile(times, 0.99) <= BUDGET + 0.5},
+            {"figure": f"{name} path length / A* (median)", "value": ratio, "unit": "ratio",
+             "reference": "grid A* path length", "reference_value": 1.0, "ratio": ratio,
+             "goal": "<= 1.2", "met": bool(ratio <= 1.2)},
+        ]
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=2))
+        print(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()
