@@ -115,7 +115,7 @@ def main() -> None:
         "RRTstar": OMPLGridPlanner(planner="RRTstar", solve_time=BUDGET, seed=1,
                                    robot_radius=ROBOT_RADIUS, clearance_distance=CLEARANCE),
     }
-    checker = planners["RRTConnect"]._checkers(costmap)[1]  # the stricter (planning) test
+    checker = planners["RRTConnect"].planning_checker(costmap)
     queries = draw_queries(costmap, world, astar, checker, count)
     print(f"warehouse {costmap.width}x{costmap.height} cells at {costmap.resolution} m, "
           f"{count} queries >= {MIN_DISTANCE} m apart, budget {BUDGET} s")

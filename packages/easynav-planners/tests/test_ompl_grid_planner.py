@@ -140,6 +140,35 @@ def test_every_returned_path_is_clear_of_obstacles(space, planner):
     assert spacing.max() <= 0.1 + 1e-6  # interpolated every interpolation_step
 
 
+def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(monkeypatch):
+    costmap = wall_map()
+    ompl = OMPLGridPlanner("Dubins", seed=1, robot_radius=0.25, clearance_distance=0.05)
+    verify, _, strict = ompl._checkers(costmap)
+    # Plan first with half the radius: shortcuts then hug the wall's end too closely.
+    loose = verify.with_radius(0.15)
+    monkeypatch.setattr(ompl, "_checkers", lambda c: (verify, loose, strict))
+    radii = []
+    original = ompl._solve
+
+    def solve(costmap, checker, start, goal):
+        radii.append(checker.radius)
+        return original(costmap, checker, start, goal)
+
+    monkeypatch.setattr(ompl, "_solve", solve)
+    retried = 0
+    for seed in range(1, 9):
+        ompl.seed = seed
+        radii.clear()
+        result = ompl.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, -math.pi / 2))
+        assert result.ok, result.reason
+        assert_clear(costmap, result.poses, 0.30)
+        assert radii[0] == pytest.approx(0.15)
+        if len(radii) == 2:
+            retried += 1
+            assert radii[1] == pytest.approx(0.30 + (0.25 + math.sqrt(2.0)) * 0.05)
+    assert retried >= 2
+
+
 def test_se2_poses_face_the_next_one_and_the_last_has_the_goal_yaw():
     result = OMPLGridPlanner(seed=3).plan(wall_map(), (2.0, 2.0, 0.0), (8.0, 2.0, -2.0))
     assert result.ok, result.reason

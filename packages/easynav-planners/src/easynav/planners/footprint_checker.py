@@ -85,6 +85,27 @@ class FootprintChecker:
             return False
         return self._free_rows[int(fy)][int(fx)] == 1
 
+    @property
+    def origin_x(self) -> float:
+        """The costmap's origin x (m)."""
+        return self._ox
+
+    @property
+    def origin_y(self) -> float:
+        """The costmap's origin y (m)."""
+        return self._oy
+
+    @property
+    def cells_per_m(self) -> float:
+        """``1 / resolution``."""
+        return self._inv
+
+    def is_on_map(self, x: float, y: float) -> bool:
+        """Whether ``(x, y)`` is on the costmap (False for non-finite input)."""
+        fx = (x - self._ox) * self._inv
+        fy = (y - self._oy) * self._inv
+        return 0.0 <= fx < self._w and 0.0 <= fy < self._h
+
     def are_free(self, xy: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`is_free` of an ``(N, 2)`` array of positions."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)

@@ -6,6 +6,7 @@ imports without it.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 import time
@@ -43,6 +44,9 @@ PLANNERS = (
 ANYTIME_PLANNERS = frozenset(
     {"RRTstar", "InformedRRTstar", "SORRTstar", "PRMstar", "BITstar", "AORRTC"}
 )
+#: Planners that ask a motion check for the last valid state (the KPIECE family): they keep
+#: OMPL's own motion validator.
+LAST_VALID_PLANNERS = frozenset({"KPIECE1", "BKPIECE1", "LBKPIECE1"})
 #: Planners that fail outside SE2 (measured: FMT and BFMT find no state in the goal region in
 #: Dubins and Reeds–Shepp) or in the one-way Dubins space (AORRTC finds no neighbours).
 SE2_ONLY = frozenset({"FMT", "BFMT"})
@@ -194,6 +198,7 @@ class OMPLGridPlanner:
         self.last_stats = PlanStats()
         self._checker: FootprintChecker | None = None
         self._checker_key: tuple | None = None
+        self._planning_checkers: tuple[FootprintChecker, FootprintChecker] | None = None
         self._ompl = import_ompl()
 
     @property
@@ -206,11 +211,21 @@ class OMPLGridPlanner:
         returned path obeys (rebuilt only for a new costmap)."""
         return self._checkers(costmap)[0]
 
-    def _checkers(self, costmap: Costmap2D) -> tuple[FootprintChecker, FootprintChecker]:
-        # (verification, planning): OMPL checks states along motions every half cell, so a
-        # motion may clip a corner of the forbidden area between two checked states by up to
-        # a quarter cell; planning with a radius half a cell larger keeps such clips inside the
-        # margin and the verification of the final path (with the true radius) passes.
+    def planning_checker(self, costmap: Costmap2D) -> FootprintChecker:
+        """The test OMPL plans with (half a cell stricter than :meth:`checker`): a start or goal
+        must pass it."""
+        return self._checkers(costmap)[1]
+
+    def _checkers(
+        self, costmap: Costmap2D
+    ) -> tuple[FootprintChecker, FootprintChecker, FootprintChecker]:
+        # (verification, planning, strict planning). OMPL checks states along motions every
+        # half cell, so a motion may clip the forbidden area between two checked states.
+        # Planning with a radius half a cell larger keeps such clips inside the margin nearly
+        # always; the final check (with the true radius) catches the rest, and the plan is then
+        # made again with the strict margin of a quarter cell + a cell diagonal, with which no
+        # point between two checked states can fail the final check (the clearance transform is
+        # 1-Lipschitz between cell centres, each point within half a diagonal of its centre).
         key = (id(costmap), id(costmap.data), costmap.stamp)
         if self._checker is None or self._checker_key != key or self._checker.costmap is not (
             costmap
@@ -218,12 +233,14 @@ class OMPLGridPlanner:
             verify = FootprintChecker(
                 costmap, self.footprint_radius, self.obstacle_cost, self.allow_unknown
             )
+            res = costmap.resolution
             self._checker = verify
-            self._planning_checker = verify.with_radius(
-                self.footprint_radius + 0.5 * costmap.resolution
+            self._planning_checkers = (
+                verify.with_radius(self.footprint_radius + 0.5 * res),
+                verify.with_radius(self.footprint_radius + (0.25 + math.sqrt(2.0)) * res),
             )
             self._checker_key = key
-        return self._checker, self._planning_checker
+        return (self._checker, *self._planning_checkers)
 
     # -- checks ---------------------------------------------------------------------------------
     def pose_problem(self, costmap: Costmap2D, x: float, y: float, what: str) -> str | None:
@@ -231,7 +248,7 @@ class OMPLGridPlanner:
         text = f"{what} ({x:.2f}, {y:.2f})"
         if not (math.isfinite(x) and math.isfinite(y)):
             return f"{text} is not finite"
-        checker = self._checkers(costmap)[1]
+        checker = self.planning_checker(costmap)
         ix, iy = costmap.world_to_cell(x, y)
         if not bool(costmap.in_bounds(ix, iy)):
             x0, y0, x1, y1 = costmap.extent()
@@ -263,13 +280,13 @@ class OMPLGridPlanner:
         if problem is not None:
             self.last_stats = PlanStats(status="invalid input")
             return PlanResult(reason=problem)
-        checker, planning_checker = self._checkers(costmap)
-        if self.seed > 0:
-            with _SEED_LOCK:
-                poses, status = self._solve(costmap, planning_checker, start, goal)
-        else:
-            poses, status = self._solve(costmap, planning_checker, start, goal)
+        checker, planning_checker, strict_checker = self._checkers(costmap)
         goal_text = f"goal ({goal[0]:.2f}, {goal[1]:.2f})"
+        with _SEED_LOCK if self.seed > 0 else contextlib.nullcontext():
+            poses, status = self._solve(costmap, planning_checker, start, goal)
+            if poses is not None and not checker.polyline_free(poses[:, :2])[0]:
+                if strict_checker.is_free(*start[:2]) and strict_checker.is_free(*goal[:2]):
+                    poses, status = self._solve(costmap, strict_checker, start, goal)
         if poses is None:
             return PlanResult(
                 reason=(
@@ -325,10 +342,17 @@ class OMPLGridPlanner:
 
         si.setStateValidityChecker(valid)
         # Motions are checked every half cell.
+        step = 0.5 * costmap.resolution
         extent = space.getMaximumExtent()
-        si.setStateValidityCheckingResolution(
-            min(0.5, 0.5 * costmap.resolution / max(extent, 1e-9))
-        )
+        si.setStateValidityCheckingResolution(min(0.5, step / max(extent, 1e-9)))
+        motion_validator = None
+        if self.state_space == "SE2" and self.planner not in LAST_VALID_PLANNERS:
+            # A straight segment checked in one numpy call: several times more motions per
+            # second than one Python callback per state.
+            from easynav.planners.straight_motion_validator import StraightMotionValidator
+
+            motion_validator = StraightMotionValidator(si, checker, step)
+            si.setMotionValidator(motion_validator)
         si.setup()
         start_state = space.allocState()
         goal_state = space.allocState()
@@ -358,6 +382,8 @@ class OMPLGridPlanner:
         status = planner.solve(ptc)
         solved_at = time.perf_counter()
         text = str(status)
+        if motion_validator is not None:
+            counter[0] += motion_validator.count  # motions count as one check each
         if not pdef.hasExactSolution():
             self.last_stats = PlanStats(text, solved_at - began, 0.0, counter[0])
             return None, text
