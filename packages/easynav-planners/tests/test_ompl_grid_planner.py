@@ -259,6 +259,7 @@ def test_impossible_goals_and_starts_are_named(goal, start, words):
         ({"planner": "Astar"}, "planner"),
         ({"planner": "FMT", "state_space": "Dubins"}, "FMT"),
         ({"planner": "AORRTC", "state_space": "Dubins"}, "symmetric"),
+        ({"planner": "PRMstar", "state_space": "Dubins"}, "symmetric"),
         ({"solve_time": 0.0}, "solve_time"),
         ({"turning_radius": math.nan}, "turning_radius"),
         ({"seed": -1}, "seed"),

@@ -48,9 +48,10 @@ ANYTIME_PLANNERS = frozenset(
 #: OMPL's own motion validator.
 LAST_VALID_PLANNERS = frozenset({"KPIECE1", "BKPIECE1", "LBKPIECE1"})
 #: Planners that fail outside SE2 (measured: FMT and BFMT find no state in the goal region in
-#: Dubins and Reeds–Shepp) or in the one-way Dubins space (AORRTC finds no neighbours).
+#: Dubins and Reeds–Shepp) or in the one-way Dubins space (AORRTC finds no neighbours; PRM and
+#: PRM* build an undirected roadmap whose paths drive some edges the wrong way, unchecked).
 SE2_ONLY = frozenset({"FMT", "BFMT"})
-NOT_DUBINS = frozenset({"AORRTC"})
+NOT_DUBINS = frozenset({"AORRTC", "PRM", "PRMstar"})
 
 _LOG_LEVEL_SET = False
 # OMPL's random seed is process-wide: a seeded plan holds this lock from seeding to the end.
@@ -174,7 +175,7 @@ class OMPLGridPlanner:
         if planner in NOT_DUBINS and state_space == "Dubins":
             raise ValueError(
                 f"planner = {planner!r} needs a symmetric distance: it does not work in the "
-                f"Dubins state space (use ReedsShepp, or another planner)"
+                f"one-way Dubins state space (use ReedsShepp, or RRT, RRTstar, BITstar)"
             )
         self.state_space = state_space
         self.planner = planner
