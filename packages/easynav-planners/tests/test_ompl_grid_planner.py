@@ -12,7 +12,34 @@ from easynav.core.types import Costmap2D
 pytest.importorskip("ompl", reason="the OMPL planner needs the [ompl] extra")
 
 from easynav.planners.footprint_checker import FootprintChecker  # noqa: E402
-from easynav.planners.ompl_grid_planner import PLANNERS, OMPLGridPlanner  # noqa: E402
+from easynav.planners.ompl_grid_planner import (  # noqa: E402
+    ANYTIME_PLANNERS,
+    PLANNERS,
+    THREADED_PLANNERS,
+    OMPLGridPlanner,
+)
+
+#: A budget no plan expected to succeed needs, even on a loaded machine (the planners used stop
+#: at their first solution or at max_iterations).
+LONG = 60.0
+
+
+def bounded(planner: str) -> dict:
+    """A budget bounded by work, not the clock, where OMPL allows it: the same result however
+    loaded the machine is. First-solution planners stop by themselves (LONG budget); anytime
+    ones after 800 iterations; PRM and PRM* (threaded: clock only) after 5 s, a hundred times
+    what they need on an idle machine."""
+    if planner in THREADED_PLANNERS:
+        return {"solve_time": 5.0}
+    if planner in ANYTIME_PLANNERS:
+        return {"solve_time": LONG, "max_iterations": 800}
+    return {"solve_time": LONG}
+
+
+def make(*args, **kwargs) -> OMPLGridPlanner:
+    """An OMPLGridPlanner with the LONG budget unless told otherwise."""
+    kwargs.setdefault("solve_time", LONG)
+    return OMPLGridPlanner(*args, **kwargs)
 
 
 def wall_map() -> Costmap2D:
@@ -128,7 +155,9 @@ def test_polyline_check_finds_a_segment_through_a_wall():
 )
 def test_every_returned_path_is_clear_of_obstacles(space, planner):
     costmap = clutter_map()
-    ompl = OMPLGridPlanner(space, planner, solve_time=0.3, seed=7, robot_radius=0.25,
+    # Bounded by iterations, not the clock: the same work however loaded the machine is (the
+    # first-solution planners stop long before).
+    ompl = OMPLGridPlanner(space, planner, **bounded(planner), seed=7, robot_radius=0.25,
                            clearance_distance=0.05, turning_radius=0.4)
     start, goal = (-0.2, -1.0, 0.0), (5.7, 3.0, 1.0)
     result = ompl.plan(costmap, start, goal)
@@ -142,7 +171,7 @@ def test_every_returned_path_is_clear_of_obstacles(space, planner):
 
 def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(monkeypatch):
     costmap = wall_map()
-    ompl = OMPLGridPlanner("Dubins", seed=1, robot_radius=0.25, clearance_distance=0.05)
+    ompl = make("Dubins", seed=1, robot_radius=0.25, clearance_distance=0.05)
     verify, _, strict = ompl._checkers(costmap)
     # Plan first with half the radius: shortcuts then hug the wall's end too closely.
     loose = verify.with_radius(0.15)
@@ -170,7 +199,7 @@ def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(
 
 
 def test_se2_poses_face_the_next_one_and_the_last_has_the_goal_yaw():
-    result = OMPLGridPlanner(seed=3).plan(wall_map(), (2.0, 2.0, 0.0), (8.0, 2.0, -2.0))
+    result = make(seed=3).plan(wall_map(), (2.0, 2.0, 0.0), (8.0, 2.0, -2.0))
     assert result.ok, result.reason
     d = np.diff(result.poses[:, :2], axis=0)
     assert np.allclose(result.poses[:-1, 2], np.arctan2(d[:, 1], d[:, 0]))
@@ -180,7 +209,7 @@ def test_se2_poses_face_the_next_one_and_the_last_has_the_goal_yaw():
 
 @pytest.mark.parametrize("radius", [0.5, 1.0])
 def test_dubins_paths_respect_the_turning_radius_and_never_reverse(radius):
-    ompl = OMPLGridPlanner("Dubins", turning_radius=radius, seed=11, interpolation_step=0.05)
+    ompl = make("Dubins", turning_radius=radius, seed=11, interpolation_step=0.05)
     result = ompl.plan(wall_map(), (2.0, 2.0, math.pi / 2), (8.0, 2.0, -math.pi / 2))
     assert result.ok, result.reason
     poses = result.poses
@@ -193,7 +222,7 @@ def test_dubins_paths_respect_the_turning_radius_and_never_reverse(radius):
 
 
 def test_reeds_shepp_reverses_to_a_goal_just_behind():
-    ompl = OMPLGridPlanner("ReedsShepp", turning_radius=1.0, seed=2, interpolation_step=0.05)
+    ompl = make("ReedsShepp", turning_radius=1.0, seed=2, interpolation_step=0.05)
     result = ompl.plan(wall_map(), (2.0, 2.0, 0.0), (1.0, 2.0, 0.0))
     assert result.ok, result.reason
     poses = result.poses
@@ -207,11 +236,11 @@ def test_the_same_seed_gives_the_same_path_and_another_seed_another():
     costmap = clutter_map()
     start, goal = (-0.2, -1.0, 0.0), (5.7, 3.0, 1.0)
     for space in ("SE2", "ReedsShepp"):
-        first = OMPLGridPlanner(space, seed=5, simplify=False).plan(costmap, start, goal)
+        first = make(space, seed=5, simplify=False).plan(costmap, start, goal)
         # Other plans in between must not matter.
-        OMPLGridPlanner(space, seed=0).plan(costmap, start, goal)
-        again = OMPLGridPlanner(space, seed=5, simplify=False).plan(costmap, start, goal)
-        other = OMPLGridPlanner(space, seed=6, simplify=False).plan(costmap, start, goal)
+        make(space, seed=0).plan(costmap, start, goal)
+        again = make(space, seed=5, simplify=False).plan(costmap, start, goal)
+        other = make(space, seed=6, simplify=False).plan(costmap, start, goal)
         assert first.ok and again.ok and other.ok
         assert np.array_equal(first.poses, again.poses)
         assert not np.array_equal(first.poses, other.poses)
@@ -248,7 +277,7 @@ def test_an_unreachable_goal_is_reported_as_such():
     ],
 )
 def test_impossible_goals_and_starts_are_named(goal, start, words):
-    result = OMPLGridPlanner(seed=1).plan(wall_map(), (*start, 0.0), (*goal, 0.0))
+    result = make(seed=1).plan(wall_map(), (*start, 0.0), (*goal, 0.0))
     assert not result.ok and words in result.reason
 
 
@@ -264,6 +293,7 @@ def test_impossible_goals_and_starts_are_named(goal, start, words):
         ({"turning_radius": math.nan}, "turning_radius"),
         ({"seed": -1}, "seed"),
         ({"obstacle_cost": 300}, "obstacle_cost"),
+        ({"planner": "PRM", "max_iterations": 10}, "second thread"),
     ],
 )
 def test_bad_parameters_are_named(kwargs, words):
@@ -274,7 +304,7 @@ def test_bad_parameters_are_named(kwargs, words):
 def test_every_planner_offered_finds_a_path_in_se2():
     costmap = wall_map()
     for name in PLANNERS:
-        result = OMPLGridPlanner(planner=name, solve_time=0.2, seed=3).plan(
-            costmap, (2.0, 2.0, 0.0), (8.0, 2.0, 0.0))
+        planner = OMPLGridPlanner(planner=name, **bounded(name), seed=3)
+        result = planner.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, 0.0))
         assert result.ok, f"{name}: {result.reason}"
         assert_clear(costmap, result.poses, 0.4)

@@ -47,7 +47,8 @@ def room() -> Costmap2D:
 
 
 def make_planner(params=None, geometry=None) -> OMPLPlanner:
-    values = {"seed": 3, **(params or {})}
+    # A long budget: RRTConnect stops at its first solution, however loaded the machine is.
+    values = {"seed": 3, "solve_time": 60.0, **(params or {})}
     context = PluginContext(
         parameters=DictParameters({f"ompl.{k}": v for k, v in values.items()}),
         namespace=f"ompl_test_{next(_namespaces)}",

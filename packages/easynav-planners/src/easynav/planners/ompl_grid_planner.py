@@ -44,6 +44,10 @@ PLANNERS = (
 ANYTIME_PLANNERS = frozenset(
     {"RRTstar", "InformedRRTstar", "SORRTstar", "PRMstar", "BITstar", "AORRTC"}
 )
+#: Planners that evaluate the termination condition in a second thread (PRM's solution check):
+#: a Python condition (max_iterations) would deadlock there (the planning thread holds the GIL
+#: while it joins that thread), so they stop by the clock only.
+THREADED_PLANNERS = frozenset({"PRM", "PRMstar"})
 #: Planners that ask a motion check for the last valid state (the KPIECE family): they keep
 #: OMPL's own motion validator.
 LAST_VALID_PLANNERS = frozenset({"KPIECE1", "BKPIECE1", "LBKPIECE1"})
@@ -194,6 +198,11 @@ class OMPLGridPlanner:
         self.allow_unknown = bool(allow_unknown)
         if int(max_iterations) < 0:
             raise ValueError(f"max_iterations = {max_iterations} must be >= 0 (0: no limit)")
+        if int(max_iterations) > 0 and planner in THREADED_PLANNERS:
+            raise ValueError(
+                f"max_iterations = {max_iterations}: {planner} checks its termination in a "
+                f"second thread and can only be stopped by the clock (set max_iterations 0)"
+            )
         self.max_iterations = int(max_iterations)
         self.range = _positive("range", range, allow_zero=True)
         self.last_stats = PlanStats()
