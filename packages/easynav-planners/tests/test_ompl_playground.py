@@ -16,7 +16,7 @@ demo = pytest.importorskip("easynav.playground.demo", reason="needs easynav-play
 pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(900)]
 
 PARAMS = Path(__file__).resolve().parents[3] / "params"
-WORLD = os.environ.get("EASYNAV_OMPL_DEMO_WORLD", "home")
+WORLD = os.environ.get("EASYNAV_OMPL_DEMO_WORLD", "depot")
 
 
 @pytest.mark.parametrize("params_file", ["ompl.params.yaml", "ompl.reeds_shepp.params.yaml"])
