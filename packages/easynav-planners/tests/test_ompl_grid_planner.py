@@ -266,6 +266,32 @@ def test_an_unreachable_goal_is_reported_as_such():
     assert "RRTConnect in SE2" in result.reason
 
 
+@pytest.mark.parametrize(("space", "yaw"), [("SE2", 0.0), ("ReedsShepp", 0.0), ("Dubins", 3.0)])
+def test_a_robot_inside_the_clearance_escapes_along_a_segment_its_body_clears(space, yaw):
+    costmap = wall_map()
+    # 0.35 m left of the wall (x 4.75): inside the 0.4 m footprint, the 0.3 m body clear. Facing
+    # the wall, a Reeds-Shepp car backs out; a Dubins car (facing away) drives out ahead.
+    robot = (4.40, 4.0, yaw)
+    ompl = make(space, seed=4, robot_radius=0.3, clearance_distance=0.1, turning_radius=0.4)
+    result = ompl.plan(costmap, robot, (2.0, 2.0, 0.0))
+    assert result.ok, result.reason
+    poses = result.poses
+    assert poses[0, :2].tolist() == [4.40, 4.0]
+    assert_clear(costmap, poses, 0.30)  # the body never touches the wall
+    # It leaves the clearance first: the distance to the wall grows along the escape.
+    assert poses[1, 0] < poses[0, 0]
+    if space != "SE2":
+        assert poses[1, 2] == pytest.approx(yaw)  # straight out along the heading, yaw kept
+    # Past the escape, the footprint (body + clearance) is clear again.
+    first_clear = int(np.argmax(ompl.checker(costmap).are_free(poses[:, :2])))
+    assert_clear(costmap, poses[first_clear:], 0.40)
+
+
+def test_a_robot_touching_an_obstacle_has_no_escape():
+    result = make(seed=1).plan(wall_map(), (4.55, 4.0, 0.0), (2.0, 2.0, 0.0))
+    assert not result.ok and "start (4.55, 4.00) is closer than" in result.reason
+
+
 @pytest.mark.parametrize(
     ("goal", "start", "words"),
     [
@@ -273,6 +299,7 @@ def test_an_unreachable_goal_is_reported_as_such():
         ((4.5, 2.0), (2.0, 2.0), "goal (4.50, 2.00) is closer than robot_radius"),
         ((12.0, 2.0), (2.0, 2.0), "goal (12.00, 2.00) is outside the map [0.00, 10.00]"),
         ((8.0, 2.0), (0.1, 2.0), "start (0.10, 2.00) is closer than robot_radius"),
+        ((8.0, 2.0), (5.0, 2.0), "start (5.00, 2.00) is inside an obstacle"),
         ((math.nan, 2.0), (2.0, 2.0), "not finite"),
     ],
 )

@@ -48,7 +48,7 @@ def room() -> Costmap2D:
 
 def make_planner(params=None, geometry=None) -> OMPLPlanner:
     # A long budget: RRTConnect stops at its first solution, however loaded the machine is.
-    values = {"seed": 3, "solve_time": 60.0, **(params or {})}
+    values = {"seed": 3, "solve_time": 60.0, "clearance_distance": 0.1, **(params or {})}
     context = PluginContext(
         parameters=DictParameters({f"ompl.{k}": v for k, v in values.items()}),
         namespace=f"ompl_test_{next(_namespaces)}",

@@ -57,6 +57,10 @@ LAST_VALID_PLANNERS = frozenset({"KPIECE1", "BKPIECE1", "LBKPIECE1"})
 SE2_ONLY = frozenset({"FMT", "BFMT"})
 NOT_DUBINS = frozenset({"AORRTC", "PRM", "PRMstar"})
 
+#: How far (m) a robot standing inside the clearance of an obstacle looks for a point to plan
+#: from (see :meth:`OMPLGridPlanner.escape_point`).
+ESCAPE_DISTANCE = 1.0
+
 _LOG_LEVEL_SET = False
 # OMPL's random seed is process-wide: a seeded plan holds this lock from seeding to the end.
 _SEED_LOCK = threading.Lock()
@@ -209,6 +213,7 @@ class OMPLGridPlanner:
         self._checker: FootprintChecker | None = None
         self._checker_key: tuple | None = None
         self._planning_checkers: tuple[FootprintChecker, FootprintChecker] | None = None
+        self._body: FootprintChecker | None = None
         self._ompl = import_ompl()
 
     @property
@@ -249,8 +254,47 @@ class OMPLGridPlanner:
                 verify.with_radius(self.footprint_radius + 0.5 * res),
                 verify.with_radius(self.footprint_radius + (0.25 + math.sqrt(2.0)) * res),
             )
+            self._body = verify.with_radius(self.robot_radius)
             self._checker_key = key
         return (self._checker, *self._planning_checkers)
+
+    def escape_point(
+        self, costmap: Costmap2D, x: float, y: float, yaw: float
+    ) -> tuple[float, float] | None:
+        """Where a robot that stands inside the clearance of an obstacle (its body clear of it)
+        gets out: the nearest point OMPL may start from within :data:`ESCAPE_DISTANCE`, first
+        straight ahead or behind along its heading (ahead only for Dubins), else in any
+        direction, reached by a straight segment its body (``robot_radius``) clears. None when
+        the body itself touches an obstacle or no such point is in reach."""
+        self._checkers(costmap)
+        body, planning = self._body, self._planning_checkers[0]
+        if not body.is_free(x, y):
+            return None
+        step = 0.5 * costmap.resolution
+        headings = [(math.cos(yaw), math.sin(yaw))]
+        if self.state_space != "Dubins":
+            headings.append((-headings[0][0], -headings[0][1]))
+        for d in np.arange(step, ESCAPE_DISTANCE + 1e-9, step):
+            for ux, uy in headings:
+                px, py = x + d * ux, y + d * uy
+                if planning.is_free(px, py) and body.polyline_free(
+                    np.array([[x, y], [px, py]])
+                )[0]:
+                    return float(px), float(py)
+        # Any direction: the free cell centres within reach, nearest first.
+        reach = math.ceil(ESCAPE_DISTANCE / costmap.resolution)
+        cx, cy = (int(v) for v in costmap.world_to_cell(x, y))
+        x0, y0 = max(cx - reach, 0), max(cy - reach, 0)
+        window = planning.free[y0 : cy + reach + 1, x0 : cx + reach + 1]
+        iy, ix = np.nonzero(window)
+        px, py = costmap.cell_to_world(ix + x0, iy + y0)
+        distance = np.hypot(px - x, py - y)
+        for k in np.argsort(distance)[:50]:
+            if distance[k] > ESCAPE_DISTANCE:
+                break
+            if body.polyline_free(np.array([[x, y], [px[k], py[k]]]))[0]:
+                return float(px[k]), float(py[k])
+        return None
 
     # -- checks ---------------------------------------------------------------------------------
     def pose_problem(self, costmap: Costmap2D, x: float, y: float, what: str) -> str | None:
@@ -285,12 +329,23 @@ class OMPLGridPlanner:
         if not all(math.isfinite(v) for v in start + goal):
             return PlanResult(reason=f"start {start} or goal {goal} is not finite")
         problem = self.pose_problem(costmap, goal[0], goal[1], "goal")
+        checker, planning_checker, strict_checker = self._checkers(costmap)
+        robot = start
+        if (
+            problem is None
+            and planning_checker.is_on_map(start[0], start[1])
+            and not planning_checker.is_free(start[0], start[1])
+        ):
+            # A robot that drifted into the clearance of a wall plans from the nearest clear
+            # point, reached by a straight segment its body clears (as SimplePlanner escapes).
+            point = self.escape_point(costmap, *start)
+            if point is not None:
+                start = (point[0], point[1], start[2])
         if problem is None:
             problem = self.pose_problem(costmap, start[0], start[1], "start")
         if problem is not None:
             self.last_stats = PlanStats(status="invalid input")
             return PlanResult(reason=problem)
-        checker, planning_checker, strict_checker = self._checkers(costmap)
         goal_text = f"goal ({goal[0]:.2f}, {goal[1]:.2f})"
         with _SEED_LOCK if self.seed > 0 else contextlib.nullcontext():
             poses, status = self._solve(costmap, planning_checker, start, goal)
@@ -300,12 +355,16 @@ class OMPLGridPlanner:
         if poses is None:
             return PlanResult(
                 reason=(
-                    f"{goal_text} is unreachable from ({start[0]:.2f}, {start[1]:.2f}): "
+                    f"{goal_text} is unreachable from ({robot[0]:.2f}, {robot[1]:.2f}): "
                     f"{self.planner} in {self.state_space} found no path within "
                     f"{self.solve_time:g} s ({status})"
                 )
             )
         ok, index = checker.polyline_free(poses[:, :2])
+        if ok and robot != start:
+            escape = self._escape_segment(robot, start)
+            ok, index = self._body.polyline_free(escape[:, :2])
+            poses = np.concatenate([escape[:-1], poses])
         if not ok:
             x, y = poses[index, 0], poses[index, 1]
             return PlanResult(
@@ -315,6 +374,16 @@ class OMPLGridPlanner:
                 )
             )
         return PlanResult(poses=poses)
+
+    def _escape_segment(self, robot, start) -> np.ndarray:
+        """Poses from the robot to the escape point every ``interpolation_step``: facing along
+        the segment in SE2, keeping the robot's yaw for a car (it drives straight ahead or back)."""
+        if self.state_space == "SE2":
+            yaw = math.atan2(start[1] - robot[1], start[0] - robot[0])
+        else:
+            yaw = robot[2]
+        ends = np.array([[robot[0], robot[1], yaw], [start[0], start[1], yaw]])
+        return densify(ends, self.interpolation_step)
 
     def _space(self, ob):
         if self.state_space == "SE2":

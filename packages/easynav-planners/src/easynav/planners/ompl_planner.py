@@ -93,8 +93,8 @@ class OMPLPlanner(PlannerMethodBase):
         Param("planner", "RRTConnect", "the OMPL geometric planner", choices=PLANNERS),
         Param("turning_radius", 0.5, "minimum turning radius (Dubins, ReedsShepp)", "m", gt=0.0),
         Param("solve_time", 1.0, "time budget of one plan", "s", gt=0.0),
-        Param("clearance_distance", 0.1, "distance kept from obstacles beyond the robot radius",
-              "m", ge=0.0),
+        Param("clearance_distance", 0.2, "distance kept from obstacles beyond the robot radius "
+              "(a follower cuts corners of the path)", "m", ge=0.0),
         Param("simplify", True, "shorten the solution (OMPL's PathSimplifier)"),
         Param("interpolation_step", 0.1, "spacing of the poses of the path", "m", gt=0.0),
         Param("seed", 0, "OMPL's random seed: > 0 gives repeatable plans; 0 a new seed each time",
