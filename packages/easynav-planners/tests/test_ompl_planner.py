@@ -122,6 +122,17 @@ def test_replans_when_the_path_ahead_is_blocked_or_the_robot_strays():
     assert planner.plan_count == 3 and third.as_xy_yaw()[0, :2].tolist() == [1.0, 2.2]
 
 
+def test_a_plan_that_starts_with_an_escape_is_kept():
+    planner = make_planner()
+    # 0.3 m from the wall at x = 4: inside the 0.25 + 0.1 m footprint, the body clear.
+    nav_state = state_with((1.0, 1.0, 0.0), robot_xy=(3.65, 1.0))
+    planner.update(nav_state)
+    path = nav_state.get("path", Path)
+    assert len(path) > 0 and path.as_xy_yaw()[0, :2].tolist() == [3.65, 1.0]
+    planner.update(nav_state)
+    assert nav_state.get("path", Path) is path and planner.plan_count == 1
+
+
 def test_an_unreachable_goal_gives_an_empty_path_and_a_warning():
     world = room()
     world.data[:, 80:82] = 254  # close the door

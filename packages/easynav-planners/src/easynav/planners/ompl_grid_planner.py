@@ -226,6 +226,12 @@ class OMPLGridPlanner:
         returned path obeys (rebuilt only for a new costmap)."""
         return self._checkers(costmap)[0]
 
+    def body_checker(self, costmap: Costmap2D) -> FootprintChecker:
+        """The test of the robot's body alone (``robot_radius``, no clearance): the rule of the
+        escape segment a path may start with."""
+        self._checkers(costmap)
+        return self._body
+
     def planning_checker(self, costmap: Costmap2D) -> FootprintChecker:
         """The test OMPL plans with (half a cell stricter than :meth:`checker`): a start or goal
         must pass it."""

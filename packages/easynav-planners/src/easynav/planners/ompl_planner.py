@@ -276,8 +276,15 @@ class OMPLPlanner(PlannerMethodBase):
         # The first pose about as near as the nearest: with cusps (Reeds–Shepp) a path passes
         # near the same place twice, and the earlier pass is the one still ahead.
         ahead = int(np.argmax(distance <= nearest + 0.1))
-        ok, _ = self.planner.checker(costmap).polyline_free(xy[ahead:])
-        return ok
+        footprint = self.planner.checker(costmap)
+        # A path may start with an escape out of the clearance, which only the body clears.
+        clear = footprint.are_free(xy[ahead:])
+        escape = int(np.argmax(clear)) if clear.any() else len(clear) - 1
+        body = self.planner.body_checker(costmap)
+        return (
+            body.polyline_free(xy[ahead : ahead + escape + 1])[0]
+            and footprint.polyline_free(xy[ahead + escape :])[0]
+        )
 
     def _fail(self, nav_state: NavState, map_frame: str, reason: str) -> None:
         self._throttle.warn(self.logger, reason, f"{self.plugin_name}: no path: {reason}")
