@@ -114,3 +114,22 @@ def test_a_new_path_starts_again_from_its_first_segment():
 def test_cusp_tolerance_is_checked():
     with pytest.raises(ValueError, match="cusp_tolerance = -1"):
         SimplePathFollower(cusp_tolerance=-1.0)
+
+
+def test_the_simple_controller_passes_the_parameters_to_its_follower():
+    from easynav.controllers.simple_controller import SimpleController
+    from easynav.core.plugins import DictParameters, PluginContext
+
+    def make(values):
+        controller = SimpleController()
+        controller.initialize(
+            PluginContext(parameters=DictParameters(values), namespace="reversing_test"),
+            "simple",
+        )
+        return controller
+
+    assert not make({}).follower.allow_reversing
+    controller = make({"simple.allow_reversing": True, "simple.cusp_tolerance": 0.2})
+    assert controller.follower.allow_reversing and controller.follower.cusp_tolerance == 0.2
+    controller.apply_parameter("allow_reversing", False)
+    assert not controller.follower.allow_reversing
