@@ -251,6 +251,7 @@ class PlaygroundNode(Node):
         data["commands_rejected"] = self._rejected_commands
         data["start_pose"] = list(self.start_pose)
         data["holds"] = [list(event) for event in self.sim.hold_events]
+        data["commands"] = [list(event) for event in self.sim.command_events]
         data["obstacles"] = [
             {"name": o.name, "started_at": getattr(o, "started_at", 0.0)}
             for o in self.sim.obstacles

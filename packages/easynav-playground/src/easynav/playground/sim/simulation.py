@@ -37,6 +37,9 @@ class Simulation:
     move whatever it is commanded; its velocities are zero and the odometry sees no motion.
     Commands are still taken, so it drives on when released. :attr:`hold_events` lists
     ``(stamp, held)`` for every change, stamped with the first step it applied to.
+    :attr:`command_events` lists ``(stamp, v, w)`` of every command the robot took, stamped
+    with the step it applied to: what reached the robot, in simulated time (a test cannot tell
+    that from when its own process happened to read the command).
 
     The laser is mounted at ``laser_offset`` ``(x, y, yaw)`` in the robot frame.
 
@@ -84,6 +87,7 @@ class Simulation:
         self._held = False
         self._was_held = False
         self.hold_events: list[tuple[float, bool]] = []
+        self.command_events: list[tuple[float, float, float]] = []
         self.commands_received = 0
         self._next_scan = scanner.period
         self._next_odom = self.odom_period
@@ -141,6 +145,7 @@ class Simulation:
         robot = self.robot
         if command is not None:
             robot.set_command(command[0], command[1], now)
+            self.command_events.append((now, *robot.command))
 
         if held != self._was_held:
             self._was_held = held
