@@ -95,3 +95,25 @@ def derive_params(
     path_topic = f"/planner_node/{planner_types[0]}/path" if planner_types else None
     Path(out_path).write_text(yaml.safe_dump(params, sort_keys=False))
     return notes, path_topic
+
+
+LASER_SCAN = "sensor_msgs/msg/LaserScan"
+
+
+def laser_scan_topics(params_path: Path) -> list[str]:
+    """The topics sensors_node reads a ``sensor_msgs/msg/LaserScan`` from, in the order of its
+    ``sensors`` list (the playground's laser must publish there: the original's Kobuki
+    playground uses ``/scan_raw``, this playground ``scan``).
+
+    Raises:
+        FileNotFoundError: no params file.
+    """
+    params = yaml.safe_load(Path(params_path).read_text())
+    sensors = _ros_parameters(params, "sensors_node") if isinstance(params, dict) else None
+    topics = []
+    for name in (sensors or {}).get("sensors", []) or []:
+        if _get(sensors, f"{name}.type") == LASER_SCAN:
+            topic = _get(sensors, f"{name}.topic")
+            if topic:
+                topics.append(str(topic))
+    return topics
