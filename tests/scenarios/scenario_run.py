@@ -194,7 +194,7 @@ class ScenarioRun:
         self._safety_executor = None
         self._safety_lock = threading.Lock()
         self.safety_protective_stop = False
-        self.safety_changes: list[tuple[float, bool]] = []
+        self.safety_changes: list[tuple[float, bool, float]] = []
         self.checks: list[Callable[[], None]] = []
 
     # ------------------------------------------------------------------ set-up, tear-down
@@ -343,8 +343,9 @@ class ScenarioRun:
         stays current.
 
         Each publication that changes ``protective_stop`` is kept in :attr:`safety_changes`
-        as ``(stamp, protective_stop)``, stamped with the simulated clock when it was sent (the
-        moment EasyNav could first know).
+        as ``(stamp, protective_stop, wall)``: this process's simulated clock and the wall clock
+        (``time.time()``) when it was sent, the moment EasyNav could first know. (The simulated
+        clock of a busy process lags the playground's; the wall clock is the machine's.)
         """
         from easynav_interfaces.msg import SafetyStatus
         from rclpy.clock import Clock, ClockType
@@ -369,6 +370,7 @@ class ScenarioRun:
         def publish() -> None:
             stop = bool(self.safety_protective_stop)
             stamp = node.get_clock().now()
+            wall = time.time()
             msg.header.stamp = stamp.to_msg()
             msg.protective_stop = stop
             msg.speed_limited = False
@@ -377,7 +379,7 @@ class ScenarioRun:
             if not sent or sent[-1] != stop:
                 sent.append(stop)
                 with self._safety_lock:
-                    self.safety_changes.append((stamp.nanoseconds * 1e-9, stop))
+                    self.safety_changes.append((stamp.nanoseconds * 1e-9, stop, wall))
 
         node.create_timer(period, publish, clock=Clock(clock_type=ClockType.STEADY_TIME))
         executor = SingleThreadedExecutor(context=self.context)
@@ -397,18 +399,18 @@ class ScenarioRun:
         except ExternalShutdownException:
             pass
 
-    def set_protective_stop(self, stop: bool) -> float:
-        """Signal (or release) a protective stop; returns the simulated time of the first
-        status sent with it (waits for it).
+    def set_protective_stop(self, stop: bool) -> tuple[float, float]:
+        """Signal (or release) a protective stop; returns ``(stamp, wall)`` of the first status
+        sent with it (see :meth:`start_safety_channel`; waits for it).
         """
         self.safety_protective_stop = bool(stop)
-        found: list[float] = []
+        found: list[tuple[float, float]] = []
 
         def sent() -> bool:
             with self._safety_lock:
                 changes = list(self.safety_changes)
             if changes and changes[-1][1] == bool(stop):
-                found.append(changes[-1][0])
+                found.append((changes[-1][0], changes[-1][2]))
                 return True
             return False
 
@@ -454,7 +456,16 @@ class ScenarioRun:
         """``(stamp, v, w)`` of every command the robot took between two stamps, from the
         playground's record (after the run): what reached the robot, in simulated time.
         """
-        return [(t, v, w) for t, v, w in self.record.get("commands", []) if start <= t <= end]
+        return [(t, v, w) for t, v, w, _ in self.record.get("commands", []) if start <= t <= end]
+
+    def first_zero_received_after(self, wall: float) -> tuple[float, float] | None:
+        """``(stamp, received)`` of the first zero command the robot received at or after the
+        wall-clock time ``wall`` (the playground's record, after the run), or None.
+        """
+        for t, v, w, received in self.record.get("commands", []):
+            if received is not None and received >= wall and v == 0.0 and w == 0.0:
+                return t, received
+        return None
 
     def pose_at(self, stamp: float) -> tuple[float, float]:
         """True position at the last recorded pose not after ``stamp`` (after the run)."""

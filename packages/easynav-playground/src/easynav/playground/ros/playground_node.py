@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -350,7 +351,7 @@ class PlaygroundNode(Node):
                 " (warned once)"
             )
         try:
-            self.sim.set_command(lin.x, ang.z)
+            self.sim.set_command(lin.x, ang.z, time.time())
         except ValueError as err:
             # A driver must not keep moving on garbage: stop and say why.
             self._rejected_commands += 1
