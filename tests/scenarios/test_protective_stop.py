@@ -68,7 +68,6 @@ def test_a_long_protective_stop_is_an_error_the_goal_stays_and_the_robot_goes_on
 
     # WARN while stopped, ERROR once the stop lasted max_stop_time; the goal stayed active.
     assert warn is not None and warn.stamp < error.stamp
-    assert warn.message.startswith("protective stop"), warn.message
     stopped_for = error.stamp - stop_at
     assert MAX_STOP_TIME <= stopped_for < MAX_STOP_TIME + 3.0, stopped_for
     assert "for too long" in error.message, error.message
