@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 
@@ -18,10 +19,17 @@ from rclpy.qos import (
 )
 
 from easynav.core.diagnostics import write_diagnostic
-from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
+from easynav.core.nav_state_keys import CMD_VEL, PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
+from easynav.core.plugins.colision_checker import (
+    COLISION_CHECKER_PARAMETERS,
+    SEARCH_RANGE,
+    ColisionChecker,
+)
+from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
 from easynav.core.ros.converters import header_to_msg, twist_to_msg
+from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.system.component_node import ComponentNode, ConfigurationError
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
 from easynav.core.velocity import VelocityOutput
@@ -42,7 +50,9 @@ class ControllerNode(ComponentNode):
     Every RT cycle: the controller computes ``cmd_vel`` (when due or triggered); after the
     recovery system proposed, :meth:`publish_cycle` selects (mux), smooths, guards and publishes.
     Parameters: ``controller_types``, ``<alias>.*``, ``robot_limits.*``, ``cmd_timeout`` (0.5 s),
-    ``cmd_vel_keepalive_period`` (0.0 s), ``use_cmd_vel_stamped`` (false).
+    ``cmd_vel_keepalive_period`` (0.0 s), ``use_cmd_vel_stamped`` (false), ``colision_checker.*``
+    (with ``colision_checker.active``, each new controller command is checked by
+    :class:`ColisionChecker` against every point perception and zeroed on a collision).
 
     Thread contract: ``cycle_rt``/``publish_cycle`` in the RT thread; ``brake`` in the thread that
     deactivates or shuts down, while the RT loop no longer cycles.
@@ -63,6 +73,7 @@ class ControllerNode(ComponentNode):
         self.last_published = Twist()
         self.published_any = False
         self.last_publish_monotonic: float | None = None
+        self.colision_checker: ColisionChecker | None = None
         system.robot_limits = self.limits_in_force
 
     # -- configuration --------------------------------------------------------------------------
@@ -90,6 +101,23 @@ class ControllerNode(ComponentNode):
                 errors.append(f"{node}.{name} = {value} must be finite and >= 0")
         if errors:
             raise ConfigurationError("; ".join(errors))
+        self._configure_colision_checker()
+
+    def _configure_colision_checker(self) -> None:
+        try:
+            values = read_parameters(
+                COLISION_CHECKER_PARAMETERS, self.params, "",
+                warn=lambda message: self.get_logger().warning(message),
+            )
+        except ParameterValueError as exc:
+            raise ConfigurationError(f"{self.get_name()}.{exc}") from None
+        self.colision_checker = None
+        if values["colision_checker.active"]:
+            self.colision_checker = ColisionChecker.from_parameters(values)
+        if values["colision_checker.debug_markers"]:
+            self.get_logger().warning(
+                "colision_checker.debug_markers: markers are not published in this version"
+            )
 
     def after_plugins_loaded(self) -> None:
         self._apply_deprecated_limits()
@@ -170,6 +198,43 @@ class ControllerNode(ComponentNode):
                 # A failing controller stops the robot: a new zero command (braked smoothly).
                 now = self.now_seconds()
                 self.nav_state.set("cmd_vel", TwistStamped(Header(now, ""), Twist()))
+            elif self.colision_checker is not None:
+                self.check_collision()
+
+    def check_collision(self) -> None:
+        """Zero the controller's command when it runs into a point (``colision_checker``).
+
+        Every point perception (grouped or not, as the original) within 2 m, fused to the
+        robot frame and downsampled. RT thread.
+        """
+        checker = self.colision_checker
+        if checker is None or not self.nav_state.has(CMD_VEL):
+            return
+        command = self.nav_state.get(CMD_VEL)
+        twist = command.twist
+        if twist.vx == 0.0:
+            return
+        frame = self.robot_frame()
+        points = (
+            PointPerceptionsOps(self.nav_state.get_by_type(PointPerception),
+                                logger=self.get_logger())
+            .fuse(frame)
+            .filter((-SEARCH_RANGE, -SEARCH_RANGE, math.nan),
+                    (SEARCH_RANGE, SEARCH_RANGE, math.nan))
+            .downsample(checker.downsample_leaf_size)
+            .as_points()
+        )
+        collision = checker.check(points, twist.vx, twist.wz)
+        if collision is None:
+            return
+        self.get_logger().warning(
+            f"colision_checker: command (v={twist.vx:.2f}, w={twist.wz:.2f}) stopped: point "
+            f"({collision.point[0]:.2f}, {collision.point[1]:.2f}) within "
+            f"{checker.robot_radius:g} m in {collision.time:.2f} s",
+            throttle_duration_sec=1.0,
+        )
+        stamp = max(self.now_seconds(), command.header.stamp)
+        self.nav_state.set(CMD_VEL, TwistStamped(Header(stamp, command.header.frame_id), Twist()))
 
     def publish_cycle(self) -> None:
         """Mux → smoother → guard → publish. RT thread, after the recovery system's RT cycle."""
