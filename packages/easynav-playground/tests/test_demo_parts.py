@@ -142,3 +142,23 @@ def test_bad_demo_arguments_exit_2_naming_the_problem(tmp_path, capsys):
     assert run_demo(world="home", waypoints=bad, output_png=None) == 2
     assert "waypoint 0" in capsys.readouterr().err
     assert build_parser().parse_args(["--speed-up", "2"]).speed_up == 2.0
+
+
+def test_derived_params_point_the_costmap_manager_at_the_map_yaml(tmp_path):
+    source = tmp_path / "costmap.yaml"
+    source.write_text(
+        "maps_manager_node:\n  ros__parameters:\n    map_types: [costmap]\n    costmap:\n"
+        "      plugin: easynav_costmap_maps_manager/CostmapMapsManager\n"
+        "      package: easynav_playground\n      map_path_file: worlds/maps/depot.yaml\n"
+        "system_node:\n  ros__parameters:\n    robot_geometry: {radius: 0.3}\n"
+    )
+    out = tmp_path / "out.yaml"
+    notes, _ = derive_params(
+        source, tmp_path / "w.map", (0, 0, 0), out, map_yaml=tmp_path / "w.yaml", robot_radius=0.15
+    )
+    params = yaml.safe_load(out.read_text())
+    maps = params["maps_manager_node"]["ros__parameters"]["costmap"]
+    assert maps["package"] == "" and maps["map_path_file"] == str(tmp_path / "w.yaml")
+    system = params["system_node"]["ros__parameters"]
+    assert system["robot_geometry"]["radius"] == 0.15 and system["use_sim_time"] is True
+    assert any("robot_geometry.radius = 0.15" in n for n in notes)

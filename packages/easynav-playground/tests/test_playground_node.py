@@ -151,3 +151,23 @@ def test_command_line_reports_an_unknown_world_and_exits_2():
     )
     assert result.returncode == 2
     assert "atlantis" in result.stderr and "home" in result.stderr
+
+
+def test_node_takes_the_worlds_robot_unless_a_parameter_overrides_it(ros_bed):
+    from rclpy.parameter import Parameter
+
+    from easynav.playground.ros.playground_node import PlaygroundNode
+
+    node = ros_bed.add(
+        PlaygroundNode(
+            context=ros_bed.context,
+            parameter_overrides=[
+                Parameter("world", value="tb3_sandbox"),
+                Parameter("laser.beams", value=90),
+            ],
+        )
+    )
+    assert node.sim.checker.robot_radius == pytest.approx(0.15)
+    assert node.get_parameter("laser.max_range").value == pytest.approx(3.5)
+    assert node.get_parameter("base.max_linear_vel").value == pytest.approx(0.5)
+    assert node.get_parameter("laser.beams").value == 90  # the explicit parameter wins

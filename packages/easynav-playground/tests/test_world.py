@@ -157,3 +157,72 @@ def test_reachability_sees_a_door_too_narrow_for_the_clearance():
     assert reachable_from(world, (1.0, 2.0), [(1.0, 3.0), (3.0, 2.0)]) == [True, False]
     grid[30:54, 40:42] = False  # 1.2 m on the 0.2 m grid
     assert reachable_from(World(grid, 0.05), (1.0, 2.0), [(3.0, 2.0)]) == [True]
+
+
+REAL_WORLDS = ("tb3_sandbox", "depot", "warehouse")
+
+
+@pytest.mark.parametrize("name", REAL_WORLDS)
+def test_real_worlds_declare_their_robot_and_reachable_waypoints(name):
+    from easynav.playground.reachability import reachable_from
+    from easynav.playground.world_description import load_waypoints
+
+    description = WorldDescription.resolve(name)
+    assert description.map_path.suffix == ".yaml" and description.map_path.exists()
+    robot = description.robot
+    assert robot.declared and 0.1 <= robot.radius <= 0.4
+    defaults = robot.parameter_defaults()
+    assert defaults["robot_radius"] == robot.radius and "laser.max_range" in defaults
+    waypoints = load_waypoints(description.waypoints_path)
+    assert len(waypoints) >= 4
+    # CostmapPlanner's rules: the map's own grid, cells farther than the radius from walls
+    # (plus 5 cm so that a goal is not on the edge of the inscribed zone).
+    starts = [description.start_pose[:2]] + [w[:2] for w in waypoints[:-1]]
+    for start, target in zip(starts, waypoints, strict=True):
+        assert reachable_from(
+            description.world,
+            start,
+            [target[:2]],
+            cell_size=description.world.resolution,
+            robot_radius=robot.radius,
+            clearance=0.05,
+        ) == [True], (start, target)
+
+
+def test_real_world_maps_are_the_shared_ones():
+    shared = Path("/work/shared/maps")
+    if not shared.exists():
+        pytest.skip("no /work/shared/maps on this machine")
+    for name in REAL_WORLDS:
+        for suffix in (".yaml", ".pgm"):
+            shipped = WORLDS_DIR / "maps" / f"{name}{suffix}"
+            assert shipped.read_bytes() == (shared / f"{name}{suffix}").read_bytes(), shipped
+
+
+def test_robot_section_errors_name_the_key(tmp_path):
+    def write(robot: str) -> Path:
+        path = tmp_path / "w.yaml"
+        path.write_text(f"map: {WORLDS_DIR / 'home.map'}\nrobot: {robot}\n")
+        return path
+
+    with pytest.raises(ValueError, match="robot.radius must be > 0"):
+        WorldDescription.from_description_file(write("{radius: -0.1}"))
+    with pytest.raises(ValueError, match=r"robot has unknown keys \['wheels'\]"):
+        WorldDescription.from_description_file(write("{wheels: 2}"))
+    with pytest.raises(ValueError, match="max_linear_vel"):
+        WorldDescription.from_description_file(write("{limits: {max_linear_vel: 0}}"))
+    with pytest.raises(ValueError, match=r"robot.laser has unknown keys \['range'\]"):
+        WorldDescription.from_description_file(write("{laser: {range: 3}}"))
+    plain = WorldDescription.from_description_file(write("{radius: 0.12, laser: {beams: 180}}"))
+    assert plain.robot.parameter_defaults() == {"robot_radius": 0.12, "laser.beams": 180}
+    assert WorldDescription.resolve("home").robot.parameter_defaults() == {}
+
+
+def test_map_server_yaml_round_trip(tmp_path):
+    grid = np.zeros((6, 9), dtype=bool)
+    grid[1, 2] = grid[5, 8] = True
+    world = World(grid, 0.1, -0.4, 1.5, name="tiny")
+    path = world.save_map_server_yaml(tmp_path / "tiny.yaml")
+    loaded = World.from_ros_map_yaml(path)
+    assert loaded.occupied.tolist() == grid.tolist()
+    assert (loaded.resolution, loaded.origin_x, loaded.origin_y) == (0.1, -0.4, 1.5)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import yaml
 
+from easynav.playground.robot_description import RobotDescription
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.world import World
@@ -35,6 +36,10 @@ class WorldDescription:
           # default; standing pause s at each intermediate waypoint) or back and forth
           - {name: crosser, speed: 0.5, start_distance: 1.3, pause: 4.0,
              waypoints: [[7.1, 4.3], [7.1, 3.4], [7.1, 5.6]]}
+        robot:                         # optional: the robot of this world (RobotDescription)
+          radius: 0.15
+          limits: {max_linear_vel: 0.3}
+          laser: {max_range: 3.5}
 
     Thread contract: plain data; build it before starting threads.
     """
@@ -45,6 +50,7 @@ class WorldDescription:
     obstacles: list[dict] = field(default_factory=list)
     waypoints_path: Path | None = None
     source: str = ""
+    robot: RobotDescription = field(default_factory=RobotDescription)
 
     def make_obstacles(self) -> list[MovingObstacle]:
         """Fresh :class:`MovingObstacle` objects (at their first waypoint); a
@@ -125,13 +131,14 @@ class WorldDescription:
         """Load a world description YAML (see the class documentation).
 
         Raises:
-            ValueError: a missing ``map`` key, a malformed ``start_pose`` or unknown keys.
+            ValueError: a missing ``map`` key, a malformed ``start_pose`` or ``robot``, or
+                unknown keys.
         """
         path = Path(path)
         data = yaml.safe_load(path.read_text())
         if not isinstance(data, dict) or "map" not in data:
             raise ValueError(f"{path}: a world description needs a 'map' key")
-        unknown = set(data) - {"map", "start_pose", "waypoints", "moving_obstacles"}
+        unknown = set(data) - {"map", "start_pose", "waypoints", "moving_obstacles", "robot"}
         if unknown:
             raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
         map_path = path.parent / data["map"]
@@ -146,6 +153,11 @@ class WorldDescription:
         if not isinstance(obstacles, list):
             raise ValueError(f"{path}: moving_obstacles must be a list")
         waypoints = data.get("waypoints")
+        robot = (
+            RobotDescription.from_dict(data["robot"], str(path))
+            if "robot" in data
+            else RobotDescription()
+        )
         return cls(
             world,
             map_path=map_path,
@@ -153,6 +165,7 @@ class WorldDescription:
             obstacles=obstacles,
             waypoints_path=path.parent / waypoints if waypoints else None,
             source=str(path),
+            robot=robot,
         )
 
 

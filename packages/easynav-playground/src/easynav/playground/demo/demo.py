@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import TextIO
 
 from easynav.playground.demo.child_process import ChildProcess
-from easynav.playground.demo.params_patch import derive_params
+from easynav.playground.demo.params_patch import derive_params, planner_plugins
 from easynav.playground.demo.progress_line import ProgressLine
 from easynav.playground.demo.run_plot import plot_run
 from easynav.playground.demo.run_summary import RunSummary
@@ -42,6 +42,7 @@ DEFAULT_PARAMS = Path(
     str(resources.files("easynav.playground") / "params" / "playground.params.yaml")
 )
 SPIN_STEP = 0.05  # s per executor wait in the main loop
+COSTMAP_PLANNER = "easynav_costmap_planner/CostmapPlanner"
 
 
 class DemoError(Exception):
@@ -119,8 +120,22 @@ def run_demo(
         run_path.mkdir(parents=True, exist_ok=True)
         map_file = run_path / "world.map"
         description.world.save_map_file(map_file)
+        # Map-server maps go to the costmap maps manager as they are (unknown cells stay
+        # unknown); a .map world is converted.
+        map_yaml = description.map_path
+        if map_yaml is None or map_yaml.suffix.lower() not in (".yaml", ".yml"):
+            map_yaml = description.world.save_map_server_yaml(run_path / "world.yaml")
+        robot = description.robot
         derived = run_path / "params.yaml"
-        notes, path_topic = derive_params(params_path, map_file, description.start_pose, derived)
+        notes, path_topic = derive_params(
+            params_path,
+            map_file,
+            description.start_pose,
+            derived,
+            map_yaml=map_yaml.resolve(),
+            robot_radius=robot.radius if robot.declared else None,
+        )
+        costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
         easynav = _easynav_command()
     except (OSError, ValueError, DemoError) as err:
         print(f"easynav demo: {err}", file=sys.stderr)
@@ -135,12 +150,25 @@ def run_demo(
     for note in notes:
         print(f"  - {note}", file=out)
     starts = [description.start_pose[:2]] + [w[:2] for w in waypoint_list[:-1]]
+    if costmap_planning:
+        # CostmapPlanner: cells of the map's own grid farther than the robot radius from walls.
+        check = {
+            "cell_size": description.world.resolution,
+            "robot_radius": description.robot.radius,
+            "clearance": 0.0,
+        }
+        rule = (
+            f"CostmapPlanner ({description.robot.radius:g} m robot on the "
+            f"{description.world.resolution:g} m map grid)"
+        )
+    else:
+        check = {}
+        rule = "SimplePlanner (0.3 m robot + 0.2 m clearance on a 0.2 m grid)"
     for i, (start, w) in enumerate(zip(starts, waypoint_list, strict=True), 1):
-        if not reachable_from(description.world, start, [w[:2]])[0]:
+        if not reachable_from(description.world, start, [w[:2]], **check)[0]:
             print(
                 f"  warning: waypoint {i} ({w[0]:.2f}, {w[1]:.2f}) looks unreachable from "
-                f"({start[0]:.2f}, {start[1]:.2f}) for SimplePlanner (0.3 m robot + 0.2 m "
-                "clearance on a 0.2 m grid)",
+                f"({start[0]:.2f}, {start[1]:.2f}) for {rule}",
                 file=out,
             )
     domain = _free_domain_id() if domain_id is None else int(domain_id)

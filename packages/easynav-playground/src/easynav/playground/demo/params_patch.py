@@ -6,7 +6,11 @@ from pathlib import Path
 
 import yaml
 
+from easynav.core.cli.params_file import load_ros_yaml
+
 SIMPLE_MAPS_MANAGER = "easynav_simple_maps_manager/SimpleMapsManager"
+#: Maps managers that load a ROS map-server YAML through ``package`` / ``map_path_file``.
+MAP_SERVER_MAPS_MANAGERS = ("easynav_costmap_maps_manager/CostmapMapsManager",)
 
 
 def _get(section: dict, dotted: str, default=None):
@@ -41,12 +45,20 @@ def _ros_parameters(params: dict, node: str) -> dict | None:
 
 
 def derive_params(
-    params_path: Path, map_file: Path, start_pose: tuple[float, float, float], out_path: Path
+    params_path: Path,
+    map_file: Path,
+    start_pose: tuple[float, float, float],
+    out_path: Path,
+    map_yaml: Path | None = None,
+    robot_radius: float | None = None,
 ) -> tuple[list[str], str | None]:
     """Write ``out_path``: the params file with the world's map and start pose, sim time on.
 
-    - every ``SimpleMapsManager`` alias loads ``map_file`` (``package`` emptied);
+    - every ``SimpleMapsManager`` alias loads ``map_file`` (a ``.map``; ``package`` emptied);
+    - every ``CostmapMapsManager`` alias loads ``map_yaml`` (the world's map-server YAML;
+      ``package`` emptied) when given;
     - every localizer alias with an ``initial_pose`` starts at ``start_pose``;
+    - ``system_node.robot_geometry.radius`` is ``robot_radius`` when given (the world's robot);
     - ``use_sim_time: true`` on every node (the playground's /clock is the time).
 
     Returns the notes of what was changed and the planner's debug path topic (None without a
@@ -56,12 +68,18 @@ def derive_params(
         FileNotFoundError: no params file.
         ValueError: not an EasyNav params file (no ``<node>: ros__parameters:`` section).
     """
-    params = yaml.safe_load(Path(params_path).read_text())
+    params = load_ros_yaml(Path(params_path).read_text())
     if not isinstance(params, dict) or not any(
         isinstance(v, dict) and "ros__parameters" in v for v in params.values()
     ):
         raise ValueError(f"{params_path}: not a ROS params file (no '<node>: ros__parameters:')")
     notes = []
+    if robot_radius is not None:
+        system = params.setdefault("system_node", {}).setdefault("ros__parameters", {})
+        if _get(system, "robot_geometry.radius") != robot_radius:
+            _set(system, "robot_geometry.radius", float(robot_radius))
+            notes.append(f"system_node.robot_geometry.radius = {robot_radius:g}, the world's robot")
+
     for node, section in params.items():
         if isinstance(section, dict) and isinstance(section.get("ros__parameters"), dict):
             if section["ros__parameters"].get("use_sim_time") is not True:
@@ -70,10 +88,15 @@ def derive_params(
 
     maps = _ros_parameters(params, "maps_manager_node") or {}
     for alias in maps.get("map_types", []) or []:
-        if _get(maps, f"{alias}.plugin") == SIMPLE_MAPS_MANAGER:
+        plugin = _get(maps, f"{alias}.plugin")
+        if plugin == SIMPLE_MAPS_MANAGER:
             _set(maps, f"{alias}.package", "")
             _set(maps, f"{alias}.map_path_file", str(map_file))
             notes.append(f"maps_manager_node.{alias} loads the world's map {map_file}")
+        elif plugin in MAP_SERVER_MAPS_MANAGERS and map_yaml is not None:
+            _set(maps, f"{alias}.package", "")
+            _set(maps, f"{alias}.map_path_file", str(map_yaml))
+            notes.append(f"maps_manager_node.{alias} loads the world's map {map_yaml}")
         else:
             notes.append(
                 f"maps_manager_node.{alias} ({_get(maps, f'{alias}.plugin')}) keeps the map of "
@@ -95,3 +118,16 @@ def derive_params(
     path_topic = f"/planner_node/{planner_types[0]}/path" if planner_types else None
     Path(out_path).write_text(yaml.safe_dump(params, sort_keys=False))
     return notes, path_topic
+
+
+def planner_plugins(params_path: Path) -> list[str]:
+    """The plugin strings of the planner aliases of a params file (empty when none or when the
+    file cannot be read: the demo only uses them to choose its reachability warning)."""
+    try:
+        params = yaml.safe_load(Path(params_path).read_text())
+    except (OSError, yaml.YAMLError):
+        return []
+    if not isinstance(params, dict):
+        return []
+    planner = _ros_parameters(params, "planner_node") or {}
+    return [str(_get(planner, f"{a}.plugin", "")) for a in planner.get("planner_types", []) or []]

@@ -98,11 +98,16 @@ class PlaygroundNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("playground", **kwargs)
-        for name, default in DEFAULT_PARAMETERS.items():
-            if not self.has_parameter(name):
-                self.declare_parameter(name, default)
+        if not self.has_parameter("world"):
+            self.declare_parameter("world", DEFAULT_PARAMETERS["world"])
         p = self._param
         self.description = WorldDescription.resolve(str(p("world")))
+        # The world's robot (radius, base limits, laser) replaces the defaults; a parameter
+        # given explicitly (an override) still wins over both.
+        defaults = {**DEFAULT_PARAMETERS, **self.description.robot.parameter_defaults()}
+        for name, default in defaults.items():
+            if not self.has_parameter(name):
+                self.declare_parameter(name, default)
         speed_up = float(p("speed_up"))
         if not (math.isfinite(speed_up) and speed_up > 0.0):
             raise ValueError(f"playground: speed_up must be finite and > 0, got {speed_up}")

@@ -259,6 +259,32 @@ class World:
         """Write the world as a ``.map`` file (loadable by SimpleMapsManager)."""
         Path(path).write_text(self.to_map_text())
 
+    def save_map_server_yaml(self, path: str | Path) -> Path:
+        """Write the world as a ROS map-server map: ``path`` (YAML, trinary) and a PGM beside it
+        (same stem; occupied 0, free 254, as map_saver writes). Returns the YAML path.
+
+        Loadable by :meth:`from_ros_map_yaml` (same grid) and by any map-server loader
+        (CostmapMapsManager).
+        """
+        import cv2  # heavy import kept local, as in from_ros_map_yaml
+
+        path = Path(path)
+        image_path = path.with_suffix(".pgm")
+        image = np.where(np.flipud(self._occupied), 0, 254).astype(np.uint8)
+        if not cv2.imwrite(str(image_path), image):
+            raise OSError(f"could not write {image_path}")
+        spec = {
+            "image": image_path.name,
+            "mode": "trinary",
+            "resolution": self.resolution,
+            "origin": [self.origin_x, self.origin_y, 0.0],
+            "negate": 0,
+            "occupied_thresh": 0.65,
+            "free_thresh": 0.25,
+        }
+        path.write_text(yaml.safe_dump(spec, sort_keys=False))
+        return path
+
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, World):
             return NotImplemented
