@@ -49,6 +49,22 @@ def test_cost_matches_a_direct_computation():
     assert opt.cost(u.ravel(), pose, goal) == pytest.approx(expected, rel=1e-12)
 
 
+@pytest.mark.parametrize("chained", [False, True])
+def test_gradient_matches_finite_differences(chained):
+    opt = MPCOptimizer(horizon_steps=4, dt=0.1, chained=chained)
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        u = rng.uniform(-1.0, 1.0, 8)
+        pose = tuple(rng.uniform(-1.0, 1.0, 3))
+        goal = tuple(rng.uniform(-2.0, 2.0, 2))
+        h = 1e-6
+        numeric = np.array([
+            (opt.cost(u + h * e, pose, goal) - opt.cost(u - h * e, pose, goal)) / (2 * h)
+            for e in np.eye(8)
+        ])
+        assert opt.gradient(u, pose, goal) == pytest.approx(numeric, rel=1e-5, abs=1e-6)
+
+
 def test_chained_prediction_integrates_the_unicycle():
     opt = MPCOptimizer(horizon_steps=2, dt=0.5, chained=True)
     states = opt.predict(np.array([[1.0, math.pi], [1.0, 0.0]]), (0.0, 0.0, 0.0))
@@ -56,7 +72,7 @@ def test_chained_prediction_integrates_the_unicycle():
     assert states[1] == pytest.approx([0.5, 0.5, math.pi / 2])
 
 
-@pytest.mark.parametrize("solver", ["L-BFGS-B", "SLSQP", "COBYLA"])
+@pytest.mark.parametrize("solver", ["L-BFGS-B", "SLSQP"])
 def test_solution_moves_towards_the_goal_within_bounds(solver):
     opt = MPCOptimizer(solver=solver)
     low, high = np.array([-0.2, -1.0]), np.array([0.5, 1.0])
@@ -74,10 +90,11 @@ def test_local_target_is_horizon_points_ahead_of_the_robot():
     assert local_target(path[:, :2], (2.99, 0.0), 5) == pytest.approx([3.0, 0.0])
 
 
+@pytest.mark.parametrize("chained", [False, True])
 @pytest.mark.parametrize(("make_path", "deviation"), [(straight_path, 0.05), (curved_path, 0.15)])
-def test_follows_the_path_and_stops_at_the_goal(make_path, deviation):
+def test_follows_the_path_and_stops_at_the_goal(make_path, deviation, chained):
     clock = Clock()
-    mpc = make_plugin(MPCController, "mpc", {}, LIMITS, clock)
+    mpc = make_plugin(MPCController, "mpc", {"chained_prediction": chained}, LIMITS, clock)
     nav_state = NavState()
     path = make_path()
     set_path(nav_state, path)

@@ -97,7 +97,7 @@ class MPCController(ControllerMethodBase):
             "chained_prediction", False, "chain the predicted steps (the original predicts "
             "each step from the current pose)",
         ),
-        Param("solver", "L-BFGS-B", "scipy.optimize.minimize method", choices=SOLVERS),
+        Param("solver", "SLSQP", "scipy.optimize.minimize method", choices=SOLVERS),
     )
     TOPICS = (
         Topic("/mpc/path", "nav_msgs/msg/Path", "pub", "reliable, depth 10",
