@@ -19,7 +19,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from datetime import UTC, datetime
+from datetime import datetime, timezone
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -107,7 +107,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--output", default=str(ROOT / "docs" / "benchmarks.md"))
     args = parser.parse_args(argv)
     load_before = os.getloadavg()[0]
-    started = datetime.now(UTC)
+    started = datetime.now(timezone.utc)
     results = []
     for script in scripts(args.only):
         print(f"== {script.relative_to(ROOT)}", flush=True)
