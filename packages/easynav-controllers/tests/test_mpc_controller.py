@@ -144,18 +144,19 @@ def test_a_runtime_change_of_the_limits_takes_effect_at_once():
     assert late and max(late) <= 0.1 + 1e-9
 
 
-def test_deprecated_limits_cap_and_idle_stops():
+def test_deprecated_limits_are_left_to_controller_node_and_idle_stops():
     clock = Clock()
     mpc = make_plugin(MPCController, "mpc", {"max_linear_velocity": 0.2}, LIMITS, clock)
-    assert mpc.limits().max_linear_vel == 0.2
-    assert mpc.limits().min_linear_vel == -0.2
+    assert mpc.params.max_linear_velocity == 0.2
+    assert MPCController.DEPRECATED_LIMITS["max_linear_velocity"] == "max_linear_vel"
+    assert mpc.limits() == LIMITS  # only the limits in force count
     nav_state = NavState()
     set_path(nav_state, straight_path())
     set_pose(nav_state, 0.0, 0.0, 0.0)
     for _ in range(20):
         mpc.update_rt(nav_state)
         clock.t += DT
-    assert 0.0 < nav_state.get("cmd_vel", TwistStamped).twist.vx <= 0.2
+    assert nav_state.get("cmd_vel", TwistStamped).twist.vx > 0.2
     nav_state.set("navigation_state", "IDLE")
     mpc.update_rt(nav_state)
     assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero()

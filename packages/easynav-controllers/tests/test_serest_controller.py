@@ -145,11 +145,11 @@ def test_runtime_limit_and_parameter_changes_take_effect_at_once():
     assert np.mean(speeds[-5:]) <= 0.11  # and the new reference speed
 
 
-def test_deprecated_limits_cap_the_limits_in_force():
+def test_deprecated_limits_are_left_to_controller_node():
     serest = make({"max_linear_speed": 0.3, "max_angular_acc": 0.5})
-    limits = serest.limits()
-    assert limits.max_linear_vel == 0.3 and limits.max_angular_acc == 0.5
-    assert limits.max_angular_decel == 0.5 and limits.max_angular_vel == LIMITS.max_angular_vel
+    assert serest.params.max_linear_speed == 0.3 and serest.params.max_angular_acc == 0.5
+    assert SerestController.DEPRECATED_LIMITS["max_angular_acc"] == "max_angular_acc"
+    assert serest.limits() == LIMITS
 
 
 def test_turns_in_place_when_facing_away_from_the_path():

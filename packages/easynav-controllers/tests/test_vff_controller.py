@@ -121,10 +121,11 @@ def test_a_runtime_change_of_the_limits_takes_effect_at_once():
     assert max(v for v, _ in run.commands) <= 0.1
 
 
-def test_zero_command_without_target_and_deprecated_caps():
+def test_zero_command_without_target_and_deprecated_limits():
     clock = Clock()
     vff = make_plugin(VffController, "vff", {"max_speed": 0.2}, LIMITS, clock)
-    assert vff.limits().max_linear_vel == 0.2
+    assert vff.params.max_speed == 0.2 and vff.limits() == LIMITS
+    assert VffController.DEPRECATED_LIMITS["max_speed"] == "max_linear_vel"
     nav_state = NavState()
     set_pose(nav_state, 0.0, 0.0, 0.0)
     vff.update_rt(nav_state)

@@ -3,34 +3,8 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import replace
 
 from easynav.core.robot import RobotLimits
-
-#: Each controller's former own limit parameters map onto these robot_limits fields.
-LIMIT_FIELDS = ("max_linear_vel", "max_angular_vel", "max_linear_acc", "max_angular_acc")
-
-
-def capped_limits(limits: RobotLimits, caps: Mapping[str, float]) -> RobotLimits:
-    """``limits`` with each field in ``caps`` lowered to the cap (NaN caps are unset).
-
-    A capped ``max_linear_vel`` also caps reversing (``min_linear_vel``); a capped acceleration
-    also caps the matching deceleration, so a deprecated per-controller limit never lets the
-    command change faster than it says.
-    """
-    changes: dict[str, float] = {}
-    for name, cap in caps.items():
-        if cap is None or math.isnan(cap):
-            continue
-        changes[name] = min(getattr(limits, name), cap)
-        if name == "max_linear_vel":
-            changes["min_linear_vel"] = max(limits.min_linear_vel, -cap)
-        elif name == "max_linear_acc":
-            changes["max_linear_decel"] = min(limits.max_linear_decel, cap)
-        elif name == "max_angular_acc":
-            changes["max_angular_decel"] = min(limits.max_angular_decel, cap)
-    return replace(limits, **changes) if changes else limits
 
 
 def _step(current: float, target: float, dt: float, acc: float, dec: float) -> float:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from easynav.controllers.command_limits import capped_limits, limit_command
+from easynav.controllers.command_limits import limit_command
 from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW
 from easynav.controllers.mpc_optimizer import SOLVERS, MPCOptimizer, wrap_angle
 from easynav.core.nav_state import NavState
@@ -75,14 +75,14 @@ class MPCController(ControllerMethodBase):
             "(only with controller_node.colision_checker.active)", "m", gt=0.0,
         ),
         Param(
-            "max_linear_velocity", math.nan,
-            "deprecated: controller_node.robot_limits.max_linear_vel; set, it caps the speed",
-            "m/s", ge=0.0, allow_nan=True,
+            "max_linear_velocity", math.nan, "deprecated: controller_node robot_limits."
+            "max_linear_vel (applied there where that is not set)", "m/s", ge=0.0,
+            allow_nan=True, dynamic=False,
         ),
         Param(
-            "max_angular_velocity", math.nan,
-            "deprecated: controller_node.robot_limits.max_angular_vel; set, it caps the turn rate",
-            "rad/s", ge=0.0, allow_nan=True,
+            "max_angular_velocity", math.nan, "deprecated: controller_node robot_limits."
+            "max_angular_vel (applied there where that is not set)", "rad/s", ge=0.0,
+            allow_nan=True, dynamic=False,
         ),
         Param("verbose", False, "log the optimiser's outcome every cycle"),
         Param(
@@ -105,6 +105,11 @@ class MPCController(ControllerMethodBase):
     )
     READS = (NAVIGATION_STATE, PATH, ROBOT_POSE, GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW)
     WRITES = (CMD_VEL,)
+    #: The original's own limits and the robot_limits field each stands for (controller_node
+    #: applies them where robot_limits does not set that field).
+    DEPRECATED_LIMITS = {
+        "max_linear_velocity": "max_linear_vel", "max_angular_velocity": "max_angular_vel",
+    }
 
     def __init__(self) -> None:
         super().__init__()
@@ -125,14 +130,6 @@ class MPCController(ControllerMethodBase):
                 f"{self.plugin_name}: MPCController needs scipy: "
                 "pip install 'easynav-controllers[mpc]'"
             ) from None
-        for name, field in (("max_linear_velocity", "max_linear_vel"),
-                            ("max_angular_velocity", "max_angular_vel")):
-            value = self.params[name]
-            if not math.isnan(value):
-                self.logger.warning(
-                    f"{self.plugin_name}.{name} is deprecated: set controller_node.robot_limits."
-                    f"{field} (it still caps the command at {value:g})"
-                )
         self._collision_active = bool(
             self.context.parameters.declare("colision_checker.active", False)
         )
@@ -163,12 +160,8 @@ class MPCController(ControllerMethodBase):
         return MPCOptimizer(p.horizon_steps, p.dt, p.chained_prediction, p.solver)
 
     def limits(self) -> RobotLimits:
-        """The limits in force, cut down by the deprecated per-controller caps if set."""
-        return capped_limits(
-            self.get_robot_limits(),
-            {"max_linear_vel": self.params.max_linear_velocity,
-             "max_angular_vel": self.params.max_angular_velocity},
-        )
+        """The limits in force (``get_robot_limits()``), read every cycle."""
+        return self.get_robot_limits()
 
     def _write(self, nav_state: NavState, now: float, v: float, w: float) -> None:
         frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame

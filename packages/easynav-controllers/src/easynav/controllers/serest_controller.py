@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 
-from easynav.controllers.command_limits import capped_limits
 from easynav.controllers.controller_keys import (
     CLOSEST_OBSTACLE_DISTANCE,
     GOAL_TOLERANCE_POSITION,
@@ -30,7 +29,7 @@ def _p(name: str, default, description: str, unit: str = "", **rules) -> Param:
     return Param(name, default, description, unit, **rules)
 
 
-#: Deprecated per-controller limits and the robot_limits field each one caps.
+#: Deprecated per-controller limits and the robot_limits field each one stands for.
 DEPRECATED_LIMITS = {
     "max_linear_speed": "max_linear_vel",
     "max_angular_speed": "max_angular_vel",
@@ -44,8 +43,8 @@ class SerestController(ControllerMethodBase):
 
     Limits: ``get_robot_limits()`` every cycle (speeds, accelerations; ``min_linear_vel`` when
     ``allow_reverse``). The original's ``max_linear_speed``, ``max_angular_speed``,
-    ``max_linear_acc``, ``max_angular_acc`` are deprecated: unset by default; set, each caps the
-    limit in force, with a warning.
+    ``max_linear_acc``, ``max_angular_acc`` are deprecated: unset by default; set, controller_node
+    applies each to its robot_limits field where the params file does not set that field.
 
     Obstacle distance: NavState ``closest_obstacle_distance`` (float) when present; else the
     nearest lethal cell of the Costmap2D in ``map`` within ``dist_search_radius``; else, when a
@@ -107,12 +106,15 @@ class SerestController(ControllerMethodBase):
         _p("a_lat_soft", 1.1, "lateral acceleration limit of the curvature speed", "m/s^2",
            **_GT0),
     ) + tuple(
-        Param(name, math.nan, f"deprecated: controller_node.robot_limits.{field}; set, it caps "
-              "that limit", ge=0.0, allow_nan=True)
+        Param(name, math.nan, f"deprecated: controller_node robot_limits.{field} (applied there "
+              "where that is not set)", ge=0.0, allow_nan=True, dynamic=False)
         for name, field in DEPRECATED_LIMITS.items()
     )
     READS = (PATH, ROBOT_POSE, MAP, CLOSEST_OBSTACLE_DISTANCE, GOAL_TOLERANCE_POSITION,
              GOAL_TOLERANCE_YAW)
+    #: The original's own limits and the robot_limits field each stands for (controller_node
+    #: applies them where robot_limits does not set that field).
+    DEPRECATED_LIMITS = DEPRECATED_LIMITS
     WRITES = (CMD_VEL, *SEREST_DEBUG_KEYS.values())
 
     def __init__(self) -> None:
@@ -125,22 +127,13 @@ class SerestController(ControllerMethodBase):
 
     def on_initialize(self) -> None:
         self.tracker = SerestTracker(self.params)
-        for name, field in DEPRECATED_LIMITS.items():
-            if not math.isnan(self.params[name]):
-                self.logger.warning(
-                    f"{self.plugin_name}.{name} is deprecated: set controller_node.robot_limits."
-                    f"{field} (it still caps that limit at {self.params[name]:g})"
-                )
         self.state = "no_path"
         self._last_time = None
         self._path = None
 
     def limits(self) -> RobotLimits:
-        """The limits in force, cut down by the deprecated per-controller caps if set."""
-        return capped_limits(
-            self.get_robot_limits(),
-            {field: self.params[name] for name, field in DEPRECATED_LIMITS.items()},
-        )
+        """The limits in force (``get_robot_limits()``), read every cycle."""
+        return self.get_robot_limits()
 
     def obstacle_distance(self, nav_state: NavState, x: float, y: float) -> float:
         """The closest obstacle's distance (see the class docstring for the sources)."""

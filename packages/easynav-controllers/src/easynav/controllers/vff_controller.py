@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from easynav.controllers.command_limits import capped_limits, limit_command
+from easynav.controllers.command_limits import limit_command
 from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW
 from easynav.controllers.path_follower import carrot_on_path
 from easynav.controllers.vff_vectors import VffVectors
@@ -58,10 +58,12 @@ class VffController(ControllerMethodBase):
         Param("obstacle_detection_y_max", 10.0, "obstacle box", "m"),
         Param("obstacle_detection_z_min", 0.10, "obstacle box", "m"),
         Param("obstacle_detection_z_max", 1.00, "obstacle box", "m"),
-        Param("max_speed", math.nan, "deprecated: controller_node.robot_limits.max_linear_vel; "
-              "set, it caps the speed", "m/s", ge=0.0, allow_nan=True),
-        Param("max_angular_speed", math.nan, "deprecated: controller_node.robot_limits."
-              "max_angular_vel; set, it caps the turn rate", "rad/s", ge=0.0, allow_nan=True),
+        Param("max_speed", math.nan, "deprecated: controller_node robot_limits.max_linear_vel "
+              "(applied there where that is not set)", "m/s", ge=0.0, allow_nan=True,
+              dynamic=False),
+        Param("max_angular_speed", math.nan, "deprecated: controller_node robot_limits."
+              "max_angular_vel (applied there where that is not set)", "rad/s", ge=0.0,
+              allow_nan=True, dynamic=False),
         Param("follow_path", True, "attract to a carrot on `path` (false: to the first goal, as "
               "the original)"),
         Param("look_ahead_dist", 0.6, "carrot distance along the path", "m", gt=0.0),
@@ -72,6 +74,9 @@ class VffController(ControllerMethodBase):
     )
     READS = (PATH, GOALS, ROBOT_POSE, GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW)
     WRITES = (CMD_VEL,)
+    #: The original's own limits and the robot_limits field each stands for (controller_node
+    #: applies them where robot_limits does not set that field).
+    DEPRECATED_LIMITS = {"max_speed": "max_linear_vel", "max_angular_speed": "max_angular_vel"}
 
     def __init__(self) -> None:
         super().__init__()
@@ -82,13 +87,6 @@ class VffController(ControllerMethodBase):
         self._aligning = False
 
     def on_initialize(self) -> None:
-        for name, field in (("max_speed", "max_linear_vel"),
-                            ("max_angular_speed", "max_angular_vel")):
-            if not math.isnan(self.params[name]):
-                self.logger.warning(
-                    f"{self.plugin_name}.{name} is deprecated: set controller_node.robot_limits."
-                    f"{field} (it still caps the command at {self.params[name]:g})"
-                )
         self.reset()
 
     def reset(self) -> None:
@@ -99,12 +97,8 @@ class VffController(ControllerMethodBase):
         self._aligning = False
 
     def limits(self) -> RobotLimits:
-        """The limits in force, cut down by the deprecated per-controller caps if set."""
-        return capped_limits(
-            self.get_robot_limits(),
-            {"max_linear_vel": self.params.max_speed,
-             "max_angular_vel": self.params.max_angular_speed},
-        )
+        """The limits in force (``get_robot_limits()``), read every cycle."""
+        return self.get_robot_limits()
 
     def target(self, nav_state: NavState, pose) -> tuple[np.ndarray, np.ndarray] | None:
         """``(carrot xy, goal xy-yaw)`` or None without a target."""

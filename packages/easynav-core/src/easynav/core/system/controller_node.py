@@ -141,7 +141,10 @@ class ControllerNode(ComponentNode):
     def _apply_deprecated_limits(self) -> None:
         overrides = self._parameter_overrides
         for lp in self.plugins:
-            for old, new in DEPRECATED_LIMIT_PARAMETERS.items():
+            # A controller whose original named its limits otherwise lists them in
+            # DEPRECATED_LIMITS (MPC: max_linear_velocity; VFF: max_speed).
+            names = DEPRECATED_LIMIT_PARAMETERS | getattr(lp.plugin, "DEPRECATED_LIMITS", {})
+            for old, new in names.items():
                 old_name = f"{lp.alias}.{old}"
                 if old_name in overrides and f"robot_limits.{new}" not in overrides:
                     value = float(overrides[old_name].value)
