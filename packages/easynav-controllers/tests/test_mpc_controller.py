@@ -24,6 +24,7 @@ from easynav.controllers.mpc_optimizer import MPCOptimizer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
 from easynav.core.robot import RobotLimits
+from easynav.core.sensors import PointPerception
 from easynav.core.types import TwistStamped
 
 LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0)
@@ -188,3 +189,28 @@ def test_commands_without_point_perceptions_and_zero_without_path():
 def test_bad_parameters_fail_configuration(params, message):
     with pytest.raises(PluginConfigurationError, match=message.replace("(", r"\(")):
         make_plugin(MPCController, "mpc", params, LIMITS)
+
+
+def test_collision_reaction_backs_away_only_with_the_checker_active():
+    for active in (False, True):
+        clock = Clock()
+        mpc = make_plugin(MPCController, "mpc", {}, LIMITS, clock,
+                          node_params={"colision_checker.active": active})
+        nav_state = NavState()
+        set_path(nav_state, straight_path())
+        set_pose(nav_state, 0.0, 0.0, 0.0)
+        for _ in range(10):
+            mpc.update_rt(nav_state)
+            clock.t += DT
+        before = nav_state.get("cmd_vel", TwistStamped).twist.vx
+        # Points 0.2 m behind the robot (robot footprint frame): nearer than safety_radius.
+        behind = np.array([[-0.2, 0.05, 0.2], [-0.2, -0.05, 0.2]])
+        nav_state.set("scan", PointPerception(behind, "base_footprint", clock.t))
+        for _ in range(10):
+            mpc.update_rt(nav_state)
+            clock.t += DT
+        after = nav_state.get("cmd_vel", TwistStamped).twist.vx
+        if active:
+            assert mpc.state == "collision" and after < 0.0 < before
+        else:
+            assert mpc.state == "following" and after > 0.0
