@@ -25,6 +25,7 @@ from easynav.controllers.serest_tracker import SEREST_DEFAULTS, SerestTracker
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
 from easynav.core.robot import RobotLimits
+from easynav.core.sensors import PointPerception
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D, TwistStamped
 
 LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0)
@@ -173,3 +174,21 @@ def test_turns_in_place_when_facing_away_from_the_path():
 def test_bad_parameters_fail_configuration(params, message):
     with pytest.raises(PluginConfigurationError, match=message):
         make(params)
+
+
+def test_point_perceptions_count_only_when_a_points_group_exists():
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    nav_state = NavState()
+    set_path(nav_state, straight_path())
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    nav_state.set("map", "a map of any other type")  # required, but not a Costmap2D
+    scan = np.array([[0.8, 0.6, 0.2], [3.0, 0.0, 0.2]])
+    nav_state.set("scan", PointPerception(scan, "base_footprint", clock.t))
+    serest.update_rt(nav_state)
+    assert nav_state.get("serest.debug.d_closest") == math.inf
+    nav_state.set_group("points", ["a_grouped_sensor"])
+    clock.t += DT
+    serest.update_rt(nav_state)
+    # 0.3 m voxels: the point (0.8, 0.6) stays the first of its voxel; (3, 0) is out of range.
+    assert nav_state.get("serest.debug.d_closest") == pytest.approx(1.0)
