@@ -63,8 +63,8 @@ class MPCController(ControllerMethodBase):
     command standing).
 
     Thread contract: ``initialize`` in the configuring thread; ``update_rt`` in the RT thread.
-    Exceptions: :class:`PluginConfigurationError` naming the parameter; ImportError naming the
-    ``mpc`` extra at configure time when scipy is missing.
+    Exceptions: :class:`PluginConfigurationError` naming the parameter, or naming the ``mpc``
+    extra when scipy is missing.
     """
 
     PARAMETERS = (
