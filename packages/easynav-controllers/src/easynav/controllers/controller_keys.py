@@ -1,20 +1,32 @@
-"""NavState keys read or written by the MPC, SeReST and VFF controllers (declared once)."""
+"""NavState keys read or written by the controllers (beyond the kernel's), declared once.
+
+The kernel declares ``path``, ``robot_pose``, ``navigation_state`` and ``cmd_vel``
+(``easynav.core.nav_state_keys``); these are the costmap stack's and the goal manager's keys a
+controller reads, with the names of the original, and SeReST's debug values.
+"""
 
 from __future__ import annotations
 
 from easynav.core.nav_state_keys import NavStateKey
 
+MAP = NavStateKey(
+    "map",
+    "Costmap2D",
+    "the dynamic costmap (costmap maps manager); absent: no obstacle terms.",
+)
+
 GOAL_TOLERANCE_POSITION = NavStateKey(
     "goal_tolerance.position",
     "float",
-    "the goal manager's position tolerance (m); the controller stops within it.",
+    "distance (m) to the last path pose within which the goal is reached (goal manager).",
 )
+
 GOAL_TOLERANCE_YAW = NavStateKey(
     "goal_tolerance.yaw",
     "float",
-    "the goal manager's yaw tolerance (rad); the controller turns to the goal yaw within it.",
+    "yaw error (rad) to the last path pose within which the goal is reached (goal manager).",
 )
-MAP = NavStateKey("map", "Costmap2D", "the dynamic costmap (after the maps manager's filters).")
+
 CLOSEST_OBSTACLE_DISTANCE = NavStateKey(
     "closest_obstacle_distance",
     "float",
