@@ -74,7 +74,8 @@ def test_ramp_start_is_the_first_cycle_and_every_output_is_within_the_ramp_from_
     assert start == robot.now
     robot.drive(0.5, 0.3)
     assert robot.out.ramp_start == start
-    assert all(abs(t.vx) <= LIMITS.max_linear_acc * (at - start) + 1e-9 for at, t in robot.published)
+    ramp = LIMITS.max_linear_acc
+    assert all(abs(t.vx) <= ramp * (at - start) + 1e-9 for at, t in robot.published)
     robot.out.reset()
     assert robot.out.ramp_start is None
 
