@@ -1,11 +1,19 @@
 # The two commands of the README. Both set up .venv/ first (quick when it is up to date).
-.PHONY: demo test setup
+.PHONY: demo test setup bench matrix
 
 demo: setup
 	.venv/bin/easynav demo
 
 test: setup
 	.venv/bin/python tools/run_tests.py
+
+# Every benchmark script of every package, one table: docs/benchmarks.md (tens of minutes).
+bench: setup
+	.venv/bin/python tools/run_benchmarks.py
+
+# Every compatible plugin combination in every world: docs/matrix.md (long: a mission per row).
+matrix: setup
+	.venv/bin/python tests/matrix/run_matrix.py
 
 setup:
 	bash tools/setup.sh

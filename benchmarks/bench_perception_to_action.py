@@ -32,6 +32,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from easynav.core.benchmarking import BenchRow, add_json_option, report
+from easynav.core.testing.dds_isolation import reserve_domain
+
 REPO = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
 SCALE = 1e-4  # m/s per valid range: the command value names the scan
@@ -182,8 +185,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=400, help="scans per measurement")
     parser.add_argument("--rate", type=float, default=20.0, help="scans per second")
+    add_json_option(parser)
     args = parser.parse_args()
-    os.environ["ROS_DOMAIN_ID"] = str(os.getpid() % 100 + 1)
+    os.environ["ROS_DOMAIN_ID"] = str(reserve_domain(f"bench/{os.getpid()}"))
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     pinger = ScanPinger()
     results = {}
@@ -213,17 +217,20 @@ def main() -> int:
           f"{args.rate:g} Hz):")
     for label, latencies in results.items():
         print(f"  {label:<42} {stats(latencies)}")
-    floor = np.percentile(results["plain DDS round trip (rclpy echo process)"], 50)
+    floor_all = results["plain DDS round trip (rclpy echo process)"]
     ours = results["EasyNav scan -> cmd_vel"]
-    print(f"  ratio of p50s (EasyNav / floor): {np.percentile(ours, 50) / floor:.2f}")
-    p50, p99 = np.percentile(ours, 50) * 1e3, np.percentile(ours, 99) * 1e3
-    print(f"  goal p50 <= 2 ms: {'met' if p50 <= 2 else 'missed'};  "
-          f"goal p99 <= 5 ms: {'met' if p99 <= 5 else 'missed'}")
-    print("  anchors: C++ EasyNav on a Raspberry Pi 4 33 ms, Nav2 377 ms (same study)")
-    amcl = REPO / "packages" / "easynav-localizers" / "benchmarks" / "bench_amcl.py"
-    if amcl.exists():
-        print("AMCL correction cost:", flush=True)
-        subprocess.run([sys.executable, str(amcl)], check=False)
+    floor_p50, floor_p99 = (float(np.percentile(floor_all, q)) * 1e3 for q in (50, 99))
+    p50, p99 = (float(np.percentile(ours, q)) * 1e3 for q in (50, 99))
+    print("  anchors: C++ EasyNav on a Raspberry Pi 4 33 ms, Nav2 377 ms (same study)\n")
+    report(
+        [
+            BenchRow("perception to action, p50", p50, "ms", "plain rclpy DDS round trip, p50",
+                     floor_p50, goal="<= 2 ms", met=p50 <= 2.0),
+            BenchRow("perception to action, p99", p99, "ms", "plain rclpy DDS round trip, p99",
+                     floor_p99, goal="<= 5 ms", met=p99 <= 5.0),
+        ],
+        args.json,
+    )
     return 0
 
 

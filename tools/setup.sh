@@ -2,7 +2,7 @@
 # Set up (or bring up to date) the development environment of EasyNav for Python:
 #   .venv/ at the repository root with every package installed (editable), the ROS 2 message
 #   packages built from their .msg files, and the test tools.
-# Idempotent and quick when nothing changed (a stamp per step). Needs Python 3.11 and, as root,
+# Idempotent and quick when nothing changed (a stamp per step). Needs Python 3.10-3.13 and, as root,
 # nothing else: every Python dependency comes from PyPI (ROS 2 Jazzy wheels included).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,10 +12,12 @@ STAMPS=$VENV/.easynav-stamps
 
 log() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
 
+# The interpreter: $PYTHON if given, else the first of these that is 3.10 to 3.13 (the versions
+# ROS 2 Jazzy's rclpy wheels exist for).
 find_python() {
-  for candidate in python3.11 python3 python; do
+  for candidate in ${PYTHON:-} python3.11 python3.12 python3.13 python3.10 python3 python; do
     if command -v "$candidate" >/dev/null 2>&1 &&
-       "$candidate" -c 'import sys; sys.exit(0 if sys.version_info[:2] == (3, 11) else 1)' 2>/dev/null; then
+       "$candidate" -c 'import sys; sys.exit(0 if (3, 10) <= sys.version_info[:2] <= (3, 13) else 1)' 2>/dev/null; then
       command -v "$candidate"; return 0
     fi
   done
@@ -26,7 +28,7 @@ find_python() {
 # comparison needs libusb-1.0-0; it prints a note instead of a figure when it is missing.)
 
 if [ ! -x "$VENV/bin/python" ]; then
-  PY=$(find_python) || { echo "setup: Python 3.11 is required (python3.11 not found)" >&2; exit 1; }
+  PY=$(find_python) || { echo "setup: Python 3.10 to 3.13 is required (none found; set PYTHON=...)" >&2; exit 1; }
   log "creating $VENV with $PY"
   "$PY" -m venv "$VENV"
 fi

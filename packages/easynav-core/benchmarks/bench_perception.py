@@ -25,6 +25,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from easynav.core.benchmarking import BenchRow, add_json_option, report
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.sensors.converters import points_from_point_cloud2
 from easynav.core.sensors.handlers import LaserScanHandler, PointCloud2Handler
@@ -149,8 +150,29 @@ def fmt(seconds: float) -> str:
     return f"{seconds * 1e3:8.2f} ms"
 
 
-def line(label: str, figures: tuple[float, float, float], goal: float | None = None) -> None:
+ROWS: list[BenchRow] = []
+
+
+def line(
+    label: str,
+    figures: tuple[float, float, float],
+    goal: float | None = None,
+    reference: tuple[str, tuple[float, float, float]] | None = None,
+) -> None:
+    """Print one figure and keep it as a row (median wall time; the reference's median)."""
     median, p90, cpu = figures
+    unit, scale = ("µs", 1e6) if median < 1e-3 else ("ms", 1e3)
+    ROWS.append(
+        BenchRow(
+            f"{label}, median",
+            median * scale,
+            unit,
+            reference[0] if reference else "",
+            reference[1][0] * scale if reference else float("nan"),
+            goal=f"<= {fmt(goal).strip()}" if goal is not None else "",
+            met=(median <= goal) if goal is not None else None,
+        )
+    )
     verdict = ""
     if goal is not None:
         verdict = f"  goal <= {fmt(goal).strip()}: {'met' if median <= goal else 'MISSED'}"
@@ -165,6 +187,7 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=200, help="timed runs per figure")
+    add_json_option(parser)
     args = parser.parse_args()
     repeat = args.repeat
     buffer = robot_tf()
@@ -252,6 +275,11 @@ def main() -> None:
         o3d_copy = timed(o3d_with_copy, cloud_repeat)
         o3d_n = len(o3d_cloud.voxel_down_sample(RESOLUTION).points)
         line(f"open3d {o3d.__version__} voxel_down_sample ({o3d_n} points out)", o3d_only)
+        ROWS.append(
+            BenchRow("voxel downsample of the 100k cloud, CPU median", downsample[2] * 1e3, "ms",
+                     f"open3d {o3d.__version__} voxel_down_sample, CPU median",
+                     o3d_only[2] * 1e3)
+        )
         line("open3d incl. numpy -> open3d -> numpy copies", o3d_copy)
         print(
             f"  ratio EasyNav downsample / open3d voxel_down_sample: "
@@ -273,11 +301,14 @@ def main() -> None:
         m[:3, 3] = (tx, ty, tz)
         mats.append(m)
     reference = timed(lambda: numpy_chain_lookup(mats), repeat * 50)
-    line("lookup_transform at a stamp (interpolated)", full, goal=20e-6)
-    line("lookup_transform latest", latest, goal=20e-6)
+    chain = ("3 numpy 4x4 matmuls", reference)
+    line("lookup_transform at a stamp (interpolated)", full, goal=20e-6, reference=chain)
+    line("lookup_transform latest", latest, goal=20e-6, reference=chain)
     line("lookup_transform_values at a stamp (no arrays)", values)
     line("reference: 3 numpy 4x4 matmuls, no lookup/interp.", reference)
     print(f"  ratio lookup_transform / numpy matmul reference: {full[2] / reference[2]:.2f} (CPU)")
+    print()
+    report(ROWS, args.json)
 
 
 if __name__ == "__main__":

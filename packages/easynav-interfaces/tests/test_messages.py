@@ -10,10 +10,14 @@ from __future__ import annotations
 import json
 import math
 import sys
-import tomllib
 from pathlib import Path
 
 import pytest
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    tomllib = pytest.importorskip("tomli")
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 TIMEOUT = 10.0  # s, for a message to arrive

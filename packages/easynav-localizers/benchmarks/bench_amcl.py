@@ -18,6 +18,7 @@ import time
 
 import numpy as np
 
+from easynav.core.benchmarking import BenchRow, add_json_option, report
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
 from easynav.core.sensors import PointPerception
@@ -67,12 +68,13 @@ def median_ms(fn, repeats: int) -> tuple[float, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=50)
+    add_json_option(parser)
     args = parser.parse_args()
+    rows = []
     world = SimpleMap.load(resolve_map_file("easynav_maps", "worlds/home.map"))
     truth = (0.0, 0.0, 0.0)
     points = scan(world, truth)
     print(f"map {world}, scan of {len(points)} points (360 beams)")
-    print(f"{'particles':>9} | {'update() p50':>12} {'p95':>7} | {'reference p50':>13} | ratio")
     for n in (100, 1000):
         namespace = f"bench_{n}"
         buffer = get_tf_buffer(namespace)
@@ -110,7 +112,13 @@ def main() -> None:
             lambda p=poses, d=downsampled, f=field: reference_scores(p, d[:, :2], world, f),
             max(5, args.repeats // 5),
         )
-        print(f"{n:>9} | {p50:>9.2f} ms {p95:>4.2f} | {ref:>10.2f} ms | {ref / p50:5.1f}x")
+        rows.append(
+            BenchRow(f"AMCL correction, {n} particles, p50", p50, "ms",
+                     "per-particle numpy loop, p50", ref,
+                     goal="faster than the per-particle loop", met=p50 < ref)
+        )
+        rows.append(BenchRow(f"AMCL correction, {n} particles, p95", p95, "ms"))
+    report(rows, args.json)
 
 
 if __name__ == "__main__":

@@ -98,6 +98,8 @@ class AMCLLocalizer(LocalizerMethodBase):
     Exceptions: :class:`PluginConfigurationError` naming the parameter.
     """
 
+    NEEDS_MAPS = ("simple_map",)
+
     def __init__(self) -> None:
         super().__init__()
         self.filter = ParticleFilter2D(1)

@@ -30,6 +30,14 @@ from easynav.maps.map_format_error import MapFormatError
 from easynav.maps.occupancy_grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 MODES = ("trinary", "scale", "raw")
+#: Every key a map YAML may hold; any other is a typo (``occupied_threshold``) and refused.
+KNOWN_KEYS = ("image", "resolution", "origin", "occupied_thresh", "free_thresh", "negate", "mode")
+#: Pixel values map_saver writes in trinary mode, and the thresholds that read them back.
+SAVED_FREE_PIXEL = 254
+SAVED_UNKNOWN_PIXEL = 205
+SAVED_OCCUPIED_PIXEL = 0
+SAVED_OCCUPIED_THRESH = 0.65
+SAVED_FREE_THRESH = 0.196
 
 
 def _number(doc: dict[str, Any], key: str, source: Path, default: Any = None) -> float:
@@ -59,6 +67,12 @@ def read_map_yaml(path: str | os.PathLike) -> dict[str, Any]:
         raise MapFormatError(f"{source}: not valid YAML ({exc})") from None
     if not isinstance(doc, dict):
         raise MapFormatError(f"{source}: expected a mapping of keys (image, resolution, ...)")
+    unknown = sorted(str(k) for k in doc if k not in KNOWN_KEYS)
+    if unknown:
+        raise MapFormatError(
+            f"{source}: unknown key(s) {', '.join(repr(k) for k in unknown)}; a map YAML has "
+            f"{', '.join(KNOWN_KEYS)}"
+        )
     image = doc.get("image")
     if not isinstance(image, str) or not image:
         raise MapFormatError(f"{source}: required key 'image' is missing or not a file name")
@@ -172,3 +186,60 @@ def load_map_yaml(path: str | os.PathLike, frame_id: str = "map") -> OccupancyGr
         origin=Pose.from_xy_yaw(x, y, yaw),
         data=np.ascontiguousarray(occupancy[::-1]),
     )
+
+
+def occupancy_to_trinary_image(
+    data: np.ndarray, free_thresh: float = 0.25, occupied_thresh: float = 0.65
+) -> np.ndarray:
+    """The trinary PGM pixels (uint8, image orientation) map_saver writes for occupancy values.
+
+    ``data[y, x]`` int8 in map orientation (row 0 at the bottom). A value ``<= free_thresh·100``
+    (rounded) is free (254), one ``>= occupied_thresh·100`` occupied (0), anything else, -1 and
+    values outside 0…100 included, unknown (205): the original's and Nav2's rule.
+    """
+    values = np.asarray(data, dtype=np.int16)
+    free_int = int(np.rint(free_thresh * 100.0))
+    occupied_int = int(np.rint(occupied_thresh * 100.0))
+    valid = (values >= 0) & (values <= 100)
+    pixels = np.full(values.shape, SAVED_UNKNOWN_PIXEL, dtype=np.uint8)
+    pixels[valid & (values <= free_int)] = SAVED_FREE_PIXEL
+    pixels[valid & (values >= occupied_int)] = SAVED_OCCUPIED_PIXEL
+    return np.ascontiguousarray(pixels[::-1])
+
+
+def save_map_yaml(
+    grid: OccupancyGrid,
+    path: str | os.PathLike,
+    free_thresh: float = 0.25,
+    occupied_thresh: float = 0.65,
+) -> tuple[Path, Path]:
+    """Write ``grid`` as a map_server map: a trinary PGM and the YAML that reads it back.
+
+    ``path`` is the YAML file; the image is written beside it with the same stem and ``.pgm``.
+    The YAML names the image by its file name and carries the thresholds that separate the three
+    pixel values (0.65 / 0.196, as map_saver writes), so loading gives back the trinary grid.
+    Returns ``(yaml_path, image_path)``. Raises :class:`OSError` (naming the file) when a file
+    cannot be written, :class:`ValueError` for thresholds outside ``0 <= free < occupied <= 1``.
+    """
+    if not 0.0 <= free_thresh < occupied_thresh <= 1.0:
+        raise ValueError(
+            f"save thresholds must satisfy 0 <= free ({free_thresh}) < occupied "
+            f"({occupied_thresh}) <= 1"
+        )
+    yaml_path = Path(path)
+    image_path = yaml_path.with_suffix(".pgm")
+    pixels = occupancy_to_trinary_image(grid.data, free_thresh, occupied_thresh)
+    yaml_path.parent.mkdir(parents=True, exist_ok=True)
+    if not cv2.imwrite(str(image_path), pixels):
+        raise OSError(f"cannot write map image {image_path}")
+    doc = {
+        "image": image_path.name,
+        "mode": "trinary",
+        "resolution": float(grid.resolution),
+        "origin": [float(grid.origin.x), float(grid.origin.y), float(grid.origin.yaw)],
+        "negate": 0,
+        "occupied_thresh": SAVED_OCCUPIED_THRESH,
+        "free_thresh": SAVED_FREE_THRESH,
+    }
+    yaml_path.write_text(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))
+    return yaml_path, image_path

@@ -66,6 +66,8 @@ class SimpleMapsManager(MapsManagerBase):
     :class:`PluginConfigurationError` naming the parameter and the file.
     """
 
+    PROVIDES_MAPS = ("simple_map",)
+
     def __init__(self) -> None:
         super().__init__()
         self._static_map: SimpleMap | None = None

@@ -48,6 +48,8 @@ class SimplePlanner(PlannerMethodBase):
     for unreachable goals (it reports them).
     """
 
+    NEEDS_MAPS = ("simple_map",)
+
     def __init__(self) -> None:
         super().__init__()
         self.planner = SimpleGridPlanner()

@@ -18,6 +18,17 @@ KNOWN_NODES = (
 )
 
 
+# ROS 2 reads params files with libyaml (rcl_yaml_param_parser), which accepts a tab as an in-line
+# separator (``dt:<TAB>0.1``, as the original's NavMap workshop files have); PyYAML's pure-Python
+# scanner rejects it. The libyaml loader reads files as ROS does (and faster).
+_ROS_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def load_ros_yaml(text: str) -> Any:
+    """Parse YAML text as ROS 2 reads params files (libyaml: tabs accepted as separators)."""
+    return yaml.load(text, Loader=_ROS_LOADER)  # noqa: S506 (a safe loader)
+
+
 class ParamsFileError(ValueError):
     """The params file is missing, unreadable or malformed; the message names file and place."""
 
@@ -32,7 +43,7 @@ def load_params_file(path: str) -> dict[str, Any]:
     if not file.is_file():
         raise ParamsFileError(f"params file not found: {path}")
     try:
-        document = yaml.safe_load(file.read_text())
+        document = load_ros_yaml(file.read_text())
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "?"

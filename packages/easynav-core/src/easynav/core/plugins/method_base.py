@@ -58,6 +58,11 @@ class MethodBase:
     #: NavState keys the plugin reads and writes (NavStateKey constants).
     READS: ClassVar[tuple[Any, ...]] = ()
     WRITES: ClassVar[tuple[Any, ...]] = ()
+    #: Map representations a maps manager writes (``costmap``, ``simple_map``...) and those a
+    #: localizer / planner / controller can work on (any one; empty: needs none). A combination
+    #: whose needs no loaded maps manager provides fails configure (see plugins.compatibility).
+    PROVIDES_MAPS: ClassVar[tuple[str, ...]] = ()
+    NEEDS_MAPS: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self) -> None:
         self.context: PluginContext = PluginContext()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Callable
 from importlib import metadata
 
 from easynav.core.sensors.errors import SensorsConfigurationError
@@ -9,6 +11,33 @@ from easynav.core.sensors.handlers import BUILTIN_HANDLERS
 from easynav.core.sensors.perception_handler import PerceptionHandler, normalize_type_name
 
 ENTRY_POINT_GROUP = "easynav.perception_handlers"
+
+#: Short type names that older params files of the original use (``type: PointCloud``); the
+#: original's sensors node accepted them. Deprecated aliases of the full message types.
+SHORT_TYPE_NAMES = {
+    "LaserScan": "sensor_msgs/msg/LaserScan",
+    "PointCloud": "sensor_msgs/msg/PointCloud2",
+    "PointCloud2": "sensor_msgs/msg/PointCloud2",
+    "Image": "sensor_msgs/msg/Image",
+    "Imu": "sensor_msgs/msg/Imu",
+    "NavSatFix": "sensor_msgs/msg/NavSatFix",
+    "GNSS": "sensor_msgs/msg/NavSatFix",
+    "Odometry": "nav_msgs/msg/Odometry",
+    "Detection3DArray": "vision_msgs/msg/Detection3DArray",
+}
+
+
+def expand_short_type_name(
+    type_name: str, parameter: str, warn: Callable[[str], None] | None = None
+) -> str:
+    """The full message type of a short alias (``LaserScan``), with a deprecation warning
+    through ``warn``; any other name unchanged."""
+    full = SHORT_TYPE_NAMES.get(type_name.strip())
+    if full is None:
+        return type_name
+    if warn is not None:
+        warn(f"{parameter} = '{type_name}' is deprecated: write the message type '{full}'")
+    return full
 
 
 def _load(name: str, target: metadata.EntryPoint | type, parameter: str) -> type:
@@ -42,14 +71,24 @@ def available_handlers() -> dict[str, metadata.EntryPoint | type]:
     return found
 
 
-def resolve_handler(sensor_id: str, type_name: str, plugin: str, node_name: str) -> type:
+def resolve_handler(
+    sensor_id: str,
+    type_name: str,
+    plugin: str,
+    node_name: str,
+    warn: Callable[[str], None] | None = None,
+) -> type:
     """The handler class for one sensor.
 
     ``plugin`` (a handler name such as ``"easynav_sensors/LaserScanHandler"``) wins; otherwise
     the handler whose ``ros_message_type`` is ``type_name`` (built-ins preferred, then plugins;
-    two plugins for one type need ``plugin`` to choose). Raises
-    :class:`SensorsConfigurationError` naming ``<node>.<sensor_id>.plugin`` or ``.type``.
+    two plugins for one type need ``plugin`` to choose). A short type name of the original
+    (``LaserScan``, ``PointCloud``) stands for its message type, with a warning through ``warn``.
+    Raises :class:`SensorsConfigurationError` naming ``<node>.<sensor_id>.plugin`` or ``.type``
+    (an unknown type with the closest known one).
     """
+    if type_name:
+        type_name = expand_short_type_name(type_name, f"{node_name}.{sensor_id}.type", warn)
     handlers = available_handlers()
     wanted = normalize_type_name(type_name) if type_name else ""
     if plugin:
@@ -92,7 +131,10 @@ def resolve_handler(sensor_id: str, type_name: str, plugin: str, node_name: str)
             f"{parameter} = '{type_name}' is handled by several plugins "
             f"({', '.join(n for n, _ in matches)}): choose one with {node_name}.{sensor_id}.plugin"
         )
+    known = sorted(types | set(SHORT_TYPE_NAMES))
+    close = difflib.get_close_matches(type_name.strip(), known, n=1, cutoff=0.5)
+    hint = f" Did you mean '{close[0]}'?" if close else ""
     raise SensorsConfigurationError(
-        f"{parameter} = '{type_name}' has no perception handler. Supported types: "
+        f"{parameter} = '{type_name}' has no perception handler.{hint} Supported types: "
         f"{', '.join(sorted(types))}"
     )

@@ -178,7 +178,9 @@ class SensorsManager:
                 f"{self._parameter(f'{sensor_id}.topic')} is not set: the topic of sensor "
                 f"'{sensor_id}'"
             )
-        handler_class = resolve_handler(sensor_id, type_name, plugin, self._node_name)
+        handler_class = resolve_handler(
+            sensor_id, type_name, plugin, self._node_name, warn=self._logger.warning
+        )
         handler = handler_class()
         handler.logger = self._logger
         try:

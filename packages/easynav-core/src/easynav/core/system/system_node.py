@@ -11,6 +11,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import String
 
+from easynav.core.plugins.compatibility import compatibility_errors
 from easynav.core.robot import RobotGeometry, RobotGeometryRegistry
 from easynav.core.system.component_node import ComponentNode
 from easynav.core.system.controller_node import ControllerNode
@@ -238,6 +239,14 @@ class SystemNode(LifecycleNode):
             if node.lifecycle_state() != "inactive":
                 return self._fail_configure(node.error_message or f"{name} failed", configured)
             configured.append(node)
+        errors = compatibility_errors(
+            {
+                name: [(lp.alias, lp.name, type(lp.plugin)) for lp in node.plugins]
+                for name, node in self.subnodes.items()
+            }
+        )
+        if errors:
+            return self._fail_configure("incompatible plugins: " + "; ".join(errors), configured)
         try:
             self._call_extensions("configure")
         except Exception as exc:

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from enum import StrEnum
+from enum import Enum
 
 
-class VelocitySource(StrEnum):
+class VelocitySource(str, Enum):
     """The sources of the velocity mux, plus the guard's and the idle states.
 
     Priority, highest first (REFERENCE.md §6): PROTECTIVE_STOP > MOTION_INHIBITED > OVERRIDE >
@@ -24,3 +24,10 @@ class VelocitySource(StrEnum):
     TIMEOUT = "timeout"
     NONE = "none"
     BRAKE = "brake"
+
+    # StrEnum's behaviour (Python >= 3.11) on 3.10 too: str() and f-strings give the value.
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)

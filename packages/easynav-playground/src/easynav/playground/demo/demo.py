@@ -375,7 +375,10 @@ def _run(
         monitor.command_rate(nav_start, nav_end) if monitor is not None else 0.0,
         rtf,
     )
+    if monitor is not None:
+        summary.late_rt_cycles = monitor.late_cycles
     truth.save(Path(record).with_name("run.json"))  # truth + EasyNav's estimates, for analysis
+    Path(record).with_name("summary.json").write_text(json.dumps(summary.to_dict(), indent=2))
     print(summary.format_table(), file=out)
     if output_png:
         plot_run(

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import yaml
 
+from easynav.core.cli.params_file import load_ros_yaml
+
 SIMPLE_MAPS_MANAGER = "easynav_simple_maps_manager/SimpleMapsManager"
 #: Maps managers that load a ROS map-server YAML through ``package`` / ``map_path_file``.
 MAP_SERVER_MAPS_MANAGERS = ("easynav_costmap_maps_manager/CostmapMapsManager",)
@@ -66,7 +68,7 @@ def derive_params(
         FileNotFoundError: no params file.
         ValueError: not an EasyNav params file (no ``<node>: ros__parameters:`` section).
     """
-    params = yaml.safe_load(Path(params_path).read_text())
+    params = load_ros_yaml(Path(params_path).read_text())
     if not isinstance(params, dict) or not any(
         isinstance(v, dict) and "ros__parameters" in v for v in params.values()
     ):

@@ -7,7 +7,7 @@ import math
 import threading
 
 import numpy as np
-from easynav_interfaces.msg import GoalManagerInfo
+from easynav_interfaces.msg import GoalManagerInfo, Heartbeat
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path as PathMsg
@@ -45,7 +45,8 @@ class RunMonitor(Node):
     - ``cmd_vel`` / ``cmd_vel_stamped``: the velocity commands (their simulated arrival times);
     - ``collisions`` (latched JSON from the playground);
     - ``easynav_manager_info``: the goals still to visit and the distance to the current one;
-    - ``path_topic``: the planner's debug path (each new plan is kept).
+    - ``path_topic``: the planner's debug path (each new plan is kept);
+    - ``easynav_heartbeat`` (when EasyNav publishes it): the late RT cycles since activation.
 
     Thread contract: callbacks run in the executor that spins this node (the demo's main
     thread); read the attributes from that thread, or under :attr:`lock`.
@@ -72,6 +73,7 @@ class RunMonitor(Node):
         self.remaining_goals: int | None = None
         self.distance_to_goal: float | None = None
         self.paths: list[np.ndarray] = []
+        self.late_cycles: int | None = None
         reliable = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
         latched = QoSProfile(
             depth=1,
@@ -88,6 +90,7 @@ class RunMonitor(Node):
         )
         if path_topic:
             self.create_subscription(PathMsg, path_topic, self._on_path, 10)
+        self.create_subscription(Heartbeat, "easynav_heartbeat", self._on_heartbeat, 10)
 
     # ------------------------------------------------------------------ callbacks
     def _on_truth(self, msg: Odometry) -> None:
@@ -100,6 +103,10 @@ class RunMonitor(Node):
                 _yaw(p.orientation),
             )
             self.speed = msg.twist.twist.linear.x
+
+    def _on_heartbeat(self, msg: Heartbeat) -> None:
+        with self.lock:
+            self.late_cycles = max(self.late_cycles or 0, int(msg.late_cycles))
 
     def _on_tf(self, msg: TFMessage) -> None:
         f = self.frames

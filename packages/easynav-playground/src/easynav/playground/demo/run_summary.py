@@ -34,6 +34,7 @@ class RunSummary:
     localisation_samples: int = 0
     command_rate: float = 0.0
     real_time_factor: float = math.nan
+    late_rt_cycles: int | None = None
 
     @property
     def all_reached(self) -> bool:
@@ -90,6 +91,30 @@ class RunSummary:
             real_time_factor=real_time_factor,
         )
 
+    def to_dict(self) -> dict:
+        """The whole-run figures as JSON-ready values (NaN as None), for tools such as the
+        integration matrix."""
+
+        def clean(value):
+            return None if isinstance(value, float) and math.isnan(value) else value
+
+        return {
+            "waypoints": len(self.waypoints),
+            "reached": sum(w.reached for w in self.waypoints),
+            "final_state": self.final_state,
+            "status_message": self.status_message,
+            "navigation_time": clean(self.nav_end - self.nav_start),
+            "distance_driven": clean(self.distance_driven),
+            "min_clearance": clean(self.min_clearance),
+            "collisions": len(self.collisions),
+            "localisation_mean": clean(self.localisation_mean),
+            "localisation_max": clean(self.localisation_max),
+            "command_rate": clean(self.command_rate),
+            "real_time_factor": clean(self.real_time_factor),
+            "late_rt_cycles": self.late_rt_cycles,
+            "success": self.success,
+        }
+
     def format_table(self) -> str:
         """The summary as plain text: a waypoint table, then the run figures."""
 
@@ -122,6 +147,8 @@ class RunSummary:
         ]
         if not math.isnan(self.real_time_factor):
             lines.append(f"simulation speed:     x{self.real_time_factor:.2f} real time")
+        if self.late_rt_cycles is not None:
+            lines.append(f"late RT cycles:       {self.late_rt_cycles} (EasyNav's heartbeat)")
         for c in self.collisions:
             lines.append(
                 f"  collision with {c.get('with')} at ({c.get('x', 0):.2f}, {c.get('y', 0):.2f}), "

@@ -203,8 +203,12 @@ class DiagnosticRecoveryManager(RecoveryManagerBase):
         now = self.now()
         if self._activated:
             self._activated = False
-            for _, evaluator in self.evaluators:
+            for alias, evaluator in self.evaluators:
                 evaluator.schedule.reset()
+                try:  # e.g. RosGraphEvaluator discovers EasyNav's topology here
+                    evaluator.on_activate()
+                except Exception as exc:
+                    self.logger.warning(f"{alias}: on_activate failed: {exc}")
             for monitor in self._monitors.values():
                 monitor.restart()
             if self.arbiter.active is None or not self.arbiter.active.REQUIRES_CONTROL:

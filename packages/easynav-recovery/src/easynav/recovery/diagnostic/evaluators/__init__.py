@@ -10,6 +10,7 @@ from easynav.recovery.diagnostic.evaluators.no_path_evaluator import NoPathEvalu
 from easynav.recovery.diagnostic.evaluators.obstacle_too_close_evaluator import (
     ObstacleTooCloseEvaluator,
 )
+from easynav.recovery.diagnostic.evaluators.ros_graph_evaluator import RosGraphEvaluator
 from easynav.recovery.diagnostic.evaluators.safety_channel_evaluator import (
     SafetyChannelEvaluator,
 )
@@ -19,5 +20,6 @@ __all__ = [
     "ControllerStuckEvaluator",
     "NoPathEvaluator",
     "ObstacleTooCloseEvaluator",
+    "RosGraphEvaluator",
     "SafetyChannelEvaluator",
 ]

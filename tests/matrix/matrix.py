@@ -1,0 +1,243 @@
+"""The integration test matrix: every compatible combination of navigation plugins × world.
+
+The combinations come from what is installed and what the plugins declare, never from a list
+written here: every maps manager, localizer, planner and controller registered by a navigation
+distribution (the kernel's Dummy plugins, the fault injectors and the playground's instruments
+are not navigation plugins), kept when each plugin's needed map representation
+(``NEEDS_MAPS``) is one the maps manager provides (``PROVIDES_MAPS``). A new plugin joins the
+matrix by being installed.
+
+Each plugin runs with its representative configuration: its section in the first params file
+under ``params/`` that uses it (every plugin ships one), or its declared defaults. The rest of
+the configuration (sensors, robot limits and geometry, recovery) is the playground's own params
+file. A run is one waypoint mission of the playground demo (``run_demo``); its figures come from
+the demo's ``summary.json``.
+"""
+
+from __future__ import annotations
+
+import copy
+import io
+import itertools
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from easynav.core.cli.params_file import load_ros_yaml
+from easynav.core.plugins.compatibility import compatible, needed_maps, provided_maps
+from easynav.core.plugins.discovery import list_plugins, load_plugin_class
+from easynav.core.plugins.plugin_kinds import ALL_KINDS
+
+ROOT = Path(__file__).resolve().parents[2]
+PARAMS_DIR = ROOT / "params"
+BASE_PARAMS = PARAMS_DIR / "playground.params.yaml"
+
+#: Distributions whose plugins are not navigation plugins (Dummy plugins, fault injectors, the
+#: playground's measuring instruments).
+NOT_NAVIGATION = {"easynav-core", "easynav-faulty", "easynav-playground"}
+
+#: The matrix's four axes: (node, types parameter, plugin kind name), in the order of a row.
+AXES = (
+    ("maps_manager_node", "map_types", "maps manager"),
+    ("localizer_node", "localizer_types", "localizer"),
+    ("planner_node", "planner_types", "planner"),
+    ("controller_node", "controller_types", "controller"),
+)
+#: Shipped worlds a combination runs in, by default: the home world and the real maps.
+WORLDS = ("home", "tb3_sandbox", "depot")
+
+
+@dataclass(frozen=True)
+class Combination:
+    """One plugin of each axis and a world."""
+
+    maps_manager: str
+    localizer: str
+    planner: str
+    controller: str
+    world: str
+
+    @property
+    def plugins(self) -> tuple[str, str, str, str]:
+        return (self.maps_manager, self.localizer, self.planner, self.controller)
+
+    @property
+    def name(self) -> str:
+        short = [p.split("/")[0].removeprefix("easynav_") for p in self.plugins]
+        return "-".join(short) + f"@{self.world}"
+
+
+@dataclass
+class Outcome:
+    """What one run of a combination gave (from the demo's summary.json)."""
+
+    combination: Combination
+    exit_code: int
+    summary: dict = field(default_factory=dict)
+    error: str = ""
+
+    @property
+    def green(self) -> bool:
+        return self.exit_code == 0 and bool(self.summary.get("success"))
+
+
+def navigation_plugins() -> dict[str, list[str]]:
+    """Installed navigation plugins by axis kind name."""
+    kinds = {kind.name: kind for kind in ALL_KINDS}
+    found: dict[str, list[str]] = {}
+    for _, _, kind_name in AXES:
+        found[kind_name] = sorted(
+            info.name
+            for info in list_plugins(kinds[kind_name])
+            if info.distribution not in NOT_NAVIGATION
+        )
+    return found
+
+
+def plugin_class(kind_name: str, name: str) -> type:
+    kind = {k.name: k for k in ALL_KINDS}[kind_name]
+    return load_plugin_class(kind, name, f"matrix.{kind_name.replace(' ', '_')}")
+
+
+def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
+    """Every compatible combination × world, in a stable order."""
+    plugins = navigation_plugins()
+    classes = {
+        (kind, name): plugin_class(kind, name) for kind, names in plugins.items() for name in names
+    }
+    combos = []
+    for maps, loc, plan, ctrl in itertools.product(
+        plugins["maps manager"], plugins["localizer"], plugins["planner"], plugins["controller"]
+    ):
+        provides = provided_maps(classes[("maps manager", maps)])
+        if not all(
+            compatible(needed_maps(classes[(kind, name)]), provides)
+            for kind, name in (("localizer", loc), ("planner", plan), ("controller", ctrl))
+        ):
+            continue
+        combos += [Combination(maps, loc, plan, ctrl, world) for world in worlds]
+    return combos
+
+
+def covering_slice(combos: list[Combination]) -> list[Combination]:
+    """A few combinations that together use every plugin at least once (greedy set cover;
+    one world per combination, taking the worlds in turn)."""
+    by_plugins: dict[tuple[str, ...], list[Combination]] = {}
+    for combo in combos:
+        by_plugins.setdefault(combo.plugins, []).append(combo)
+    uncovered = {p for combo in combos for p in combo.plugins}
+    chosen: list[Combination] = []
+    while uncovered:
+        plugins = max(by_plugins, key=lambda ps: (len(set(ps) & uncovered), ps))
+        options = by_plugins[plugins]
+        chosen.append(options[len(chosen) % len(options)])
+        uncovered -= set(plugins)
+    return chosen
+
+
+def representative_sections() -> dict[str, dict]:
+    """For each plugin name, its configuration in the first params file under params/ that
+    uses it (alias section, plus the node-level parameters of that node in that file)."""
+    sections: dict[str, dict] = {}
+    for path in sorted(PARAMS_DIR.glob("*.yaml")):
+        try:
+            document = load_ros_yaml(path.read_text())
+        except yaml.YAMLError:
+            continue
+        if not isinstance(document, dict):
+            continue
+        for node, types_key, _ in AXES:
+            params = (document.get(node) or {}).get("ros__parameters") or {}
+            for alias in params.get(types_key) or []:
+                section = params.get(alias)
+                if not isinstance(section, dict) or "plugin" not in section:
+                    continue
+                sections.setdefault(
+                    section["plugin"],
+                    {"file": path.name, "alias": alias, "section": copy.deepcopy(section)},
+                )
+    return sections
+
+
+def compose_params(combo: Combination, sections: dict[str, dict] | None = None) -> dict:
+    """The params document of one combination: the playground's file with each axis replaced
+    by the chosen plugin's representative section (alias ``matrix``); the heartbeat on, so the
+    run reports late RT cycles."""
+    sections = representative_sections() if sections is None else sections
+    document = load_ros_yaml(BASE_PARAMS.read_text())
+    for (node, types_key, _), plugin in zip(AXES, combo.plugins, strict=True):
+        params = document.setdefault(node, {}).setdefault("ros__parameters", {})
+        for alias in params.get(types_key) or []:
+            params.pop(alias, None)
+        known = sections.get(plugin)
+        section = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
+        params[types_key] = ["matrix"]
+        params["matrix"] = section
+    system = document.setdefault("system_node", {}).setdefault("ros__parameters", {})
+    system.setdefault("safety", {}).setdefault("heartbeat", {})["period"] = 0.5
+    return document
+
+
+def run_combination(
+    combo: Combination, run_dir: Path, speed_up: float = 1.0, timeout: float = 600.0
+) -> Outcome:
+    """Run one combination's waypoint mission in the playground."""
+    from easynav.playground.demo import run_demo
+
+    run_dir.mkdir(parents=True, exist_ok=True)
+    params = run_dir / "matrix.params.yaml"
+    params.write_text(yaml.safe_dump(compose_params(combo), sort_keys=False))
+    out = io.StringIO()
+    try:
+        code = run_demo(
+            world=combo.world,
+            params_file=params,
+            speed_up=speed_up,
+            output_png=run_dir / "run.png",
+            timeout=timeout,
+            run_dir=run_dir / "run",
+            stream=out,
+        )
+    except Exception as exc:  # a crash of the harness is a row, not the end of the matrix
+        return Outcome(combo, 1, error=f"{type(exc).__name__}: {exc}")
+    summary_path = run_dir / "run" / "summary.json"
+    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+    error = ""
+    if code != 0:
+        lines = [line for line in out.getvalue().splitlines() if line.strip()]
+        error = summary.get("status_message") or (lines[-1] if lines else f"exit {code}")
+    return Outcome(combo, code, summary, error)
+
+
+def _num(value, fmt: str) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "—"
+    return format(value, fmt)
+
+
+def markdown(outcomes: list[Outcome], header: str) -> str:
+    """docs/matrix.md: one row per run."""
+    lines = [
+        header,
+        "",
+        "| maps manager | localizer | planner | controller | world | reached | time (s) | "
+        "distance (m) | min clearance (m) | loc. error mean / max (m) | late RT cycles | verdict |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for o in outcomes:
+        s, c = o.summary, o.combination
+        verdict = "green" if o.green else f"**FAILED**: {o.error or 'see the run'}"
+        lines.append(
+            f"| `{c.maps_manager}` | `{c.localizer}` | `{c.planner}` | `{c.controller}` | "
+            f"{c.world} | {s.get('reached', 0)}/{s.get('waypoints', '?')} | "
+            f"{_num(s.get('navigation_time'), '.1f')} | {_num(s.get('distance_driven'), '.1f')} | "
+            f"{_num(s.get('min_clearance'), '.2f')} | "
+            f"{_num(s.get('localisation_mean'), '.3f')} / {_num(s.get('localisation_max'), '.3f')}"
+            f" | {_num(s.get('late_rt_cycles'), 'd')} | {verdict.replace('|', '/')} |"
+        )
+    green = sum(o.green for o in outcomes)
+    lines += ["", f"{green} of {len(outcomes)} runs green.", ""]
+    return "\n".join(lines)

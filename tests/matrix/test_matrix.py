@@ -1,0 +1,75 @@
+"""The integration matrix: combinations from the plugins' declarations, and CI's slice of it.
+
+The slice (every installed navigation plugin at least once) runs as slow tests; `make matrix`
+runs every combination in every world and writes docs/matrix.md.
+"""
+
+from __future__ import annotations
+
+import pytest
+from matrix import (
+    AXES,
+    Combination,
+    combinations,
+    compose_params,
+    covering_slice,
+    navigation_plugins,
+    representative_sections,
+    run_combination,
+)
+
+from easynav.core.plugins.compatibility import compatible, needed_maps, provided_maps
+
+
+def test_every_installed_navigation_plugin_is_in_some_combination():
+    combos = combinations(("home",))
+    used = {p for combo in combos for p in combo.plugins}
+    for kind, names in navigation_plugins().items():
+        assert names, f"no {kind} installed"
+        for name in names:
+            assert name in used, f"{name} ({kind}) is in no compatible combination"
+
+
+def test_no_combination_pairs_a_plugin_with_a_map_it_cannot_use():
+    from matrix import plugin_class
+
+    for combo in combinations(("home",)):
+        provides = provided_maps(plugin_class("maps manager", combo.maps_manager))
+        for kind, name in zip(("localizer", "planner", "controller"), combo.plugins[1:],
+                              strict=True):
+            assert compatible(needed_maps(plugin_class(kind, name)), provides), combo
+
+
+def test_the_slice_covers_every_plugin():
+    combos = combinations()
+    chosen = covering_slice(combos)
+    assert {p for c in chosen for p in c.plugins} == {p for c in combos for p in c.plugins}
+    assert len(chosen) <= max(len(names) for names in navigation_plugins().values()) + 2
+
+
+def test_composed_params_take_each_plugin_from_its_representative_file():
+    sections = representative_sections()
+    combo = combinations(("home",))[0]
+    document = compose_params(combo, sections)
+    for (node, types_key, _), plugin in zip(AXES, combo.plugins, strict=True):
+        params = document[node]["ros__parameters"]
+        assert params[types_key] == ["matrix"]
+        assert params["matrix"]["plugin"] == plugin
+        if plugin in sections:
+            assert params["matrix"] == sections[plugin]["section"]
+    heartbeat = document["system_node"]["ros__parameters"]["safety"]["heartbeat"]
+    assert heartbeat["period"] > 0
+
+
+SLICE = covering_slice(combinations())
+
+
+@pytest.mark.slow
+@pytest.mark.ros
+@pytest.mark.timeout(900)
+@pytest.mark.parametrize("combo", SLICE, ids=[c.name for c in SLICE])
+def test_slice_combination_completes_its_mission(combo: Combination, tmp_path):
+    outcome = run_combination(combo, tmp_path, timeout=600.0)
+    summary = outcome.summary
+    assert outcome.green, f"{combo.name}: {outcome.error}\n{summary}"
+    assert summary["collisions"] == 0 and summary["reached"] == summary["waypoints"]

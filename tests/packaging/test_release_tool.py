@@ -1,0 +1,84 @@
+"""tools/release.py: the consistency check, the refused bump, and the repository's own set."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+spec = importlib.util.spec_from_file_location("release", REPO / "tools" / "release.py")
+release = importlib.util.module_from_spec(spec)
+sys.modules["release"] = release
+spec.loader.exec_module(release)
+
+
+def write_package(root: Path, name: str, version: str, deps: list[str], changelog=True) -> None:
+    folder = root / name
+    folder.mkdir(parents=True)
+    quoted = ", ".join(f'"{d}"' for d in deps)
+    (folder / "pyproject.toml").write_text(
+        f'[project]\nname = "{name}"\nversion = "{version}"\ndependencies = [{quoted}]\n'
+    )
+    if changelog:
+        (folder / "CHANGELOG.md").write_text(f"# {name}\n\n## {version}\n\n- first\n")
+
+
+@pytest.fixture
+def monorepo(tmp_path):
+    write_package(tmp_path, "easynav-core", "0.1.0", ["numpy>=1.26,<3"])
+    write_package(tmp_path, "easynav-maps", "0.1.0", ["easynav-core>=0.1.0,<0.2"])
+    return tmp_path
+
+
+def test_the_repository_set_is_consistent():
+    assert release.check(release.load_packages()) == []
+
+
+def test_a_consistent_set_passes(monorepo):
+    assert release.check(release.load_packages(monorepo)) == []
+
+
+def test_unbounded_and_unpinned_dependencies_are_named(tmp_path):
+    write_package(tmp_path, "easynav-core", "0.1.0", ["numpy>=1.26"], changelog=False)
+    write_package(tmp_path, "easynav-maps", "0.1.0", ["easynav-core", "opencv-python-headless"])
+    problems = release.check(release.load_packages(tmp_path))
+    assert "easynav-core: no CHANGELOG.md" in problems
+    assert ("easynav-core: dependency 'numpy>=1.26' needs a tested range: a lower and an "
+            "upper bound") in problems
+    assert "easynav-maps: dependency 'easynav-core' has no version range" in problems
+
+
+def test_a_sibling_range_that_excludes_the_sibling_is_named(tmp_path):
+    write_package(tmp_path, "easynav-core", "0.2.0", [])
+    write_package(tmp_path, "easynav-maps", "0.1.0", ["easynav-core>=0.1.0,<0.2"])
+    assert release.check(release.load_packages(tmp_path)) == [
+        "easynav-maps: dependency 'easynav-core<0.2,>=0.1.0' does not admit easynav-core 0.2.0 "
+        "(the repository's)"
+    ]
+
+
+def test_a_bump_a_dependent_does_not_admit_is_refused(monorepo):
+    packages = release.load_packages(monorepo)
+    with pytest.raises(release.ReleaseError, match=r"easynav-maps requires 'easynav-core"):
+        release.bump(packages, "easynav-core", "minor")
+    assert 'version = "0.1.0"' in (monorepo / "easynav-core" / "pyproject.toml").read_text()
+
+
+def test_a_bump_within_the_ranges_writes_the_version_and_a_changelog_section(monorepo):
+    packages = release.load_packages(monorepo)
+    assert str(release.bump(packages, "easynav-core", "patch")) == "0.1.1"
+    assert 'version = "0.1.1"' in (monorepo / "easynav-core" / "pyproject.toml").read_text()
+    changelog = (monorepo / "easynav-core" / "CHANGELOG.md").read_text()
+    assert changelog.index("## 0.1.1") < changelog.index("## 0.1.0")
+    assert release.check(release.load_packages(monorepo)) == []
+
+
+def test_the_lowest_sibling_is_the_range_lower_bound():
+    packages = release.load_packages()
+    core = packages["easynav-core"]
+    req = next(r for r in packages["easynav-planners"].requirements if r.name == "easynav-core")
+    assert release.lower_bound(req.specifier) <= core.version
+    assert release.commit_with_version(core, core.version) is not None

@@ -1,0 +1,143 @@
+"""Run every benchmark script of every package and write one table: docs/benchmarks.md.
+
+Usage: .venv/bin/python tools/run_benchmarks.py [--only SUBSTRING] [--output PATH]
+
+Finds ``packages/*/benchmarks/bench_*.py`` and ``benchmarks/bench_*.py``, runs each in its own
+process with ``--json`` (the project's benchmark convention: rows of figure, value, unit,
+reference, reference value, ratio, goal, met), one after the other so they do not load each
+other, and writes a Markdown table with the machine, the date and the load it ran under. A
+script that fails or times out gets a row saying so, with the tail of its output.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+TIMEOUT = 900.0
+
+
+def scripts(only: str | None) -> list[Path]:
+    found = sorted(ROOT.glob("packages/*/benchmarks/bench_*.py")) + sorted(
+        ROOT.glob("benchmarks/bench_*.py")
+    )
+    return [p for p in found if only is None or only in str(p)]
+
+
+def cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def run_one(script: Path) -> tuple[list[dict], str, float]:
+    """The script's rows, an error text ("" when it ran), and its wall time."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "rows.json"
+        start = time.monotonic()
+        try:
+            proc = subprocess.run(
+                [sys.executable, str(script), "--json", str(out)],
+                cwd=ROOT, capture_output=True, text=True, timeout=TIMEOUT,
+            )
+        except subprocess.TimeoutExpired:
+            return [], f"timed out after {TIMEOUT:.0f} s", time.monotonic() - start
+        took = time.monotonic() - start
+        sys.stdout.write(proc.stdout[-4000:])
+        if proc.returncode != 0 or not out.exists():
+            tail = (proc.stderr or proc.stdout).strip().splitlines()[-3:]
+            return [], f"exit {proc.returncode}: " + " / ".join(tail), took
+        return json.loads(out.read_text()), "", took
+
+
+def cell(value) -> str:
+    if value is None:
+        return "—"
+    if isinstance(value, float):
+        return f"{value:.3g}" if abs(value) < 1000 else f"{value:.0f}"
+    return str(value).replace("|", "\\|")
+
+
+def markdown(results: list[tuple[Path, list[dict], str, float]], header: list[str]) -> str:
+    lines = header + [
+        "",
+        "| script | figure | value | unit | reference | ref. value | ratio | goal | met |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    met = missed = 0
+    for script, rows, error, _ in results:
+        name = str(script.relative_to(ROOT))
+        if error:
+            lines.append(f"| `{name}` | **did not run** | | | | | | {cell(error)} | NO |")
+            missed += 1
+            continue
+        for row in rows:
+            verdict = row.get("met")
+            if verdict is True:
+                met += 1
+            elif verdict is False:
+                missed += 1
+            mark = "—" if verdict is None else ("yes" if verdict else "**NO**")
+            lines.append(
+                f"| `{name}` | {cell(row['figure'])} | {cell(row['value'])} | "
+                f"{cell(row['unit'])} | {cell(row.get('reference') or None)} | "
+                f"{cell(row.get('reference_value'))} | {cell(row.get('ratio'))} | "
+                f"{cell(row.get('goal') or None)} | {mark} |"
+            )
+    lines += ["", f"Goals met: {met}; missed or not run: {missed}.", ""]
+    return "\n".join(lines)
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", help="run only scripts whose path contains this")
+    parser.add_argument("--output", default=str(ROOT / "docs" / "benchmarks.md"))
+    args = parser.parse_args(argv)
+    load_before = os.getloadavg()[0]
+    started = datetime.now(timezone.utc)
+    results = []
+    for script in scripts(args.only):
+        print(f"== {script.relative_to(ROOT)}", flush=True)
+        rows, error, took = run_one(script)
+        if error:
+            print(f"   FAILED: {error}", flush=True)
+        results.append((script, rows, error, took))
+    commit = subprocess.run(
+        ["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True
+    ).stdout.strip()
+    header = [
+        "# Benchmarks",
+        "",
+        "Written by `make bench` (tools/run_benchmarks.py): every benchmark script of every "
+        "package, each comparing this project's figure with a reference measured in the same "
+        "run on the same input. Ratios travel between machines better than times do.",
+        "",
+        f"- date: {started:%Y-%m-%d %H:%M} UTC; commit {commit or 'unknown'}",
+        f"- machine: {cpu_model()}, {os.cpu_count()} CPUs, {platform.system()} "
+        f"{platform.release()}, Python {platform.python_version()}",
+        f"- load average (1 min) before: {load_before:.2f}, after: {os.getloadavg()[0]:.2f} "
+        "(a shared machine: other processes take cores, which widens the p99 figures)",
+        "- scripts: " + ", ".join(f"`{s.relative_to(ROOT)}` ({t:.0f} s)" for s, _, _, t in results),
+    ]
+    text = markdown(results, header)
+    Path(args.output).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.output).write_text(text)
+    print(f"\nwrote {args.output}")
+    return 0 if all(not error for _, _, error, _ in results) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
