@@ -51,6 +51,7 @@ def hit_fractions(
     grid,
     field: np.ndarray | None = None,
     chunk: int = 128,
+    compiled: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     """For each particle pose ``(x, y, yaw)``: the fraction of ``points_xy`` (robot frame) that
     hit occupied cells of ``grid`` (a :class:`SimpleMap` or a Costmap2D, see
@@ -60,7 +61,9 @@ def hit_fractions(
     hit; None counts exact hits on occupied cells (the original's score). A particle whose
     points all fall off the map scores 0. Vectorised over particles × points, in float32 cell
     units and ``chunk`` particles at a time, which keeps the intermediate arrays in cache (4–5×
-    faster than one float64 pass for 1000 particles).
+    faster than one float64 pass for 1000 particles). With numba installed (and ``compiled``)
+    the same scoring runs as one compiled loop (``_scoring_numba``), several times faster again;
+    this numpy version is its reference.
     """
     n = len(poses)
     fractions = np.zeros(n)
@@ -72,6 +75,18 @@ def hit_fractions(
     elif field.shape != (grid.height, grid.width):
         raise ValueError(
             f"likelihood field shape {field.shape} != map shape {(grid.height, grid.width)}"
+        )
+    kernel = _compiled_scoring() if compiled else None
+    if kernel is not None:
+        return kernel(
+            np.ascontiguousarray(poses, dtype=np.float64),
+            np.ascontiguousarray(points_xy[:, :2], dtype=np.float64),
+            np.ascontiguousarray(field, dtype=np.float32).ravel(),
+            grid.width,
+            grid.height,
+            float(grid.origin_x),
+            float(grid.origin_y),
+            float(grid.resolution),
         )
     inv = 1.0 / grid.resolution
     px = (points_xy[:, 0] * inv).astype(np.float32)[None, :]
@@ -96,6 +111,22 @@ def hit_fractions(
         possible[a:b] = count
         np.divide(hits.sum(axis=1, dtype=np.float64), count, out=fractions[a:b], where=count > 0)
     return fractions, possible
+
+
+_SCORING = None
+
+
+def _compiled_scoring():
+    """The numba scoring kernel, compiled on first use (None without numba)."""
+    global _SCORING
+    if _SCORING is None:
+        try:
+            from easynav.localizers._scoring_numba import score_kernel
+        except ImportError:
+            _SCORING = False
+        else:
+            _SCORING = score_kernel
+    return _SCORING or None
 
 
 class ParticleFilter2D:
