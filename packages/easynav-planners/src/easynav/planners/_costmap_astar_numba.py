@@ -86,7 +86,8 @@ def astar_kernel(costs, sx, sy, gx, gy, cost_factor, heuristic_scale, diagonal_c
     # "cheaper" test by itself, and a popped entry of a closed cell is stale. The start (g 0)
     # is popped first and never pushed again, so -0.0 needs no special case.
     g = np.full(n, np.inf)
-    parent = np.full(n, -1, dtype=np.int32)
+    # Read only along the final path, whose cells were all written: no initial fill needed.
+    parent = np.empty(n, dtype=np.int32)
     start = (sy + 1) * pw + sx + 1
     goal = (gy + 1) * pw + gx + 1
     if padded[goal] >= _BLOCKED:
