@@ -1,5 +1,5 @@
 # The two commands of the README. Both set up .venv/ first (quick when it is up to date).
-.PHONY: demo test setup bench matrix
+.PHONY: demo test setup bench matrix dist isolated
 
 demo: setup
 	.venv/bin/easynav demo
@@ -14,6 +14,15 @@ bench: setup
 # Every compatible plugin combination in every world: docs/matrix.md (long: a mission per row).
 matrix: setup
 	.venv/bin/python tests/matrix/run_matrix.py
+
+# A wheel and an sdist of every distribution, in dist/.
+dist: setup
+	.venv/bin/python tools/release.py build
+
+# Every distribution installed alone in a fresh venv, its tests against the lowest and the
+# highest sibling versions its ranges allow (long).
+isolated: setup
+	.venv/bin/python tools/release.py isolated-all
 
 setup:
 	bash tools/setup.sh

@@ -9,10 +9,13 @@ Usage: .venv/bin/python tools/release.py COMMAND ...
   bump PKG {major,minor,patch}
                              new version of one package (pyproject + a CHANGELOG section);
                              refused when a dependent's range would not admit it
-  isolated PKG [--python PY] [--siblings lowest|highest] [-- PYTEST_ARGS]
-                             a fresh virtual environment with only PKG's wheel, its declared
-                             dependencies and the wheels of the siblings it declares (at the
-                             lowest or highest version their ranges allow); PKG's tests there
+  isolated PKG [PKG ...] [--python PY] [--siblings lowest|highest] [-- PYTEST_ARGS]
+                             a fresh virtual environment with only the PKGs' wheels, their
+                             declared dependencies and the wheels of the siblings they declare
+                             (at the lowest or highest version the ranges allow); the PKGs'
+                             own tests there
+  isolated-all [--python PY]  every package alone, against the lowest and the highest
+                             sibling versions (the whole range check; long)
 
 Sibling versions: "highest" is the repository's current version of each sibling; "lowest" is the
 sibling as it was at the newest commit whose version equals the range's lower bound (found in the
@@ -189,7 +192,7 @@ def build_folder(folder: Path, out: Path, python: str = sys.executable) -> list[
     result = subprocess.run(
         [python, "-m", "build", "--sdist", "--wheel", "--outdir", str(out), *isolation,
          str(folder)],
-        capture_output=True, text=True,
+        capture_output=True, text=True, env=clean_environment(),
     )
     if result.returncode != 0:
         raise ReleaseError(f"building {folder.name} failed:\n{result.stdout[-3000:]}"
@@ -233,10 +236,13 @@ def sibling_folder(pkg: Package, req: Requirement, siblings: str, work: Path) ->
     return target / pkg.folder.relative_to(ROOT)
 
 
-def closure(packages: dict[str, Package], name: str) -> list[tuple[Package, Requirement | None]]:
-    """``name`` and every sibling it needs, directly or through another sibling."""
-    seen: dict[str, tuple[Package, Requirement | None]] = {name: (packages[name], None)}
-    todo = [packages[name]]
+def closure(
+    packages: dict[str, Package], names: list[str]
+) -> list[tuple[Package, Requirement | None]]:
+    """The named packages and every sibling they need, directly or through another sibling
+    (with the requirement that brought it in; None for the named ones)."""
+    seen: dict[str, tuple[Package, Requirement | None]] = {n: (packages[n], None) for n in names}
+    todo = [packages[n] for n in names]
     while todo:
         for req in todo.pop().requirements:
             if req.name in packages and req.name not in seen:
@@ -247,18 +253,20 @@ def closure(packages: dict[str, Package], name: str) -> list[tuple[Package, Requ
 
 def isolated(
     packages: dict[str, Package],
-    name: str,
+    names: list[str],
     python: str,
     siblings: str,
     pytest_args: list[str],
 ) -> int:
-    """Install ``name`` alone (with its declared dependencies) in a fresh venv; run its tests."""
-    if name not in packages:
-        raise ReleaseError(f"no package {name!r}")
-    work = Path(tempfile.mkdtemp(prefix=f"easynav-isolated-{name}-"))
+    """Install the named packages alone (with their declared dependencies) in a fresh venv;
+    run their tests there."""
+    for name in names:
+        if name not in packages:
+            raise ReleaseError(f"no package {name!r}")
+    work = Path(tempfile.mkdtemp(prefix="easynav-isolated-"))
     try:
         wheels = work / "wheels"
-        for pkg, req in closure(packages, name):
+        for pkg, req in closure(packages, names):
             folder = pkg.folder if req is None else sibling_folder(pkg, req, siblings, work)
             # The message package has compiled parts: built by the target Python, in a build
             # environment of its own unless that Python is this one.
@@ -270,21 +278,29 @@ def isolated(
         run([python, "-m", "venv", str(venv)])
         vpy = str(venv / "bin" / "python")
         run([vpy, "-m", "pip", "install", "--quiet", "--upgrade", "pip"])
-        pkg = packages[name]
-        test_extra = "[test]" if "test" in pkg.extras else ""
-        wheel = next(wheels.glob(pkg.name.replace("-", "_") + "-*.whl"))
-        run([vpy, "-m", "pip", "install", "--quiet", "--find-links", str(wheels),
-             f"{wheel}{test_extra}", "pytest>=8", "pytest-xdist>=3.5", "pytest-timeout>=2.3",
-             "hypothesis>=6.100"])
+        targets = []
+        installed = {pkg.name for pkg, _ in closure(packages, names)}
+        for name in names:
+            pkg = packages[name]
+            extra = "[test]" if "test" in pkg.extras else ""
+            wheel = next(wheels.glob(pkg.name.replace("-", "_") + "-*.whl"))
+            targets.append(f"{wheel}{extra}")
+        if "easynav-core" in installed and "easynav-core" not in names:
+            # The kernel's test extra: its fixtures and test tools serve every package's tests.
+            core = next(wheels.glob("easynav_core-*.whl"))
+            targets.append(f"{core}[test]")
+        run([vpy, "-m", "pip", "install", "--quiet", "--find-links", str(wheels), *targets])
         listed = run([vpy, "-m", "pip", "list", "--format=freeze"]).stdout
         ours = sorted(line for line in listed.splitlines() if line.lower().startswith("easynav"))
-        print(f"[isolated] {name} with {python} ({siblings} siblings): " + ", ".join(ours))
-        env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
-        tests = pkg.folder / "tests"
+        version = run([vpy, "--version"]).stdout.strip()
+        print(f"[isolated] {', '.join(names)} on {version} ({siblings} siblings): "
+              + ", ".join(ours), flush=True)
+        env = clean_environment()
         # From a copy of the tests outside the repository: nothing but the installed wheels is
         # importable (the repository's conftest gives each test process its ROS domain).
         shutil.copy(ROOT / "conftest.py", work / "conftest.py")
-        shutil.copytree(tests, work / "tests")
+        for name in names:
+            shutil.copytree(packages[name].folder / "tests", work / "tests" / name)
         (work / "pytest.ini").write_text(
             "[pytest]\naddopts = -ra --import-mode=importlib -p no:cacheprovider\n"
             "timeout = 300\nmarkers =\n  slow: long\n  ros: ROS\n  rt: real time\n"
@@ -295,6 +311,16 @@ def isolated(
         ).returncode
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def clean_environment() -> dict[str, str]:
+    """This process's environment without what the ROS wheels' start-up set for *this* venv
+    (its library path and the guard that says it is set): a Python of another venv must set
+    its own, or rclpy there loads this venv's libraries."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("LD_LIBRARY_PATH", "_ROS_WHEELS_BOOTSTRAP_COMPLETE", "VIRTUAL_ENV")}
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    return env
 
 
 def same_python(a: str, b: str) -> bool:
@@ -317,7 +343,7 @@ def build_environment(python: str, work: Path, folder: Path) -> str:
 
 
 def run(cmd: list[str]) -> subprocess.CompletedProcess:
-    result = subprocess.run(cmd, capture_output=True, text=True)
+    result = subprocess.run(cmd, capture_output=True, text=True, env=clean_environment())
     if result.returncode != 0:
         raise ReleaseError(f"{' '.join(cmd)} failed:\n{result.stdout[-3000:]}"
                            f"\n{result.stderr[-3000:]}")
@@ -334,9 +360,11 @@ def main(argv: list[str]) -> int:
     p_bump.add_argument("package")
     p_bump.add_argument("level", choices=("major", "minor", "patch"))
     p_iso = sub.add_parser("isolated")
-    p_iso.add_argument("package")
+    p_iso.add_argument("package", nargs="+")
     p_iso.add_argument("--python", default=sys.executable)
     p_iso.add_argument("--siblings", choices=("lowest", "highest"), default="highest")
+    p_all = sub.add_parser("isolated-all")
+    p_all.add_argument("--python", default=sys.executable)
     # Everything after "--" goes to pytest.
     pytest_args: list[str] = []
     if "--" in argv:
@@ -362,6 +390,17 @@ def main(argv: list[str]) -> int:
             new = bump(packages, args.package, args.level)
             print(f"{args.package} {new}: edit its CHANGELOG.md section, then commit")
             return 0
+        if args.command == "isolated-all":
+            failed = []
+            for name in sorted(packages):
+                for siblings in ("lowest", "highest"):
+                    code = isolated(packages, [name], args.python, siblings,
+                                    pytest_args or ["-q", "-m", "not slow", "-n", "2"])
+                    if code != 0:
+                        failed.append(f"{name} ({siblings} siblings): exit {code}")
+            for line in failed:
+                print(f"release isolated-all: FAILED {line}", file=sys.stderr)
+            return 1 if failed else 0
         return isolated(packages, args.package, args.python, args.siblings, pytest_args)
     except ReleaseError as exc:
         print(f"release: {exc}", file=sys.stderr)

@@ -1,18 +1,65 @@
-"""The whole test suite: ruff over the tree, then pytest over every package and tests/.
+"""The whole test suite: ruff, the release consistency check, pytest over every package and
+tests/, then the kernel and a plugin distribution installed alone on the oldest and the newest
+supported Python.
 
 Usage: .venv/bin/python tools/run_tests.py [--fast] [pytest args...]
-  --fast   skip scenarios marked slow (they always run in CI)
+  --fast   skip scenarios marked slow and the isolated installs (they always run in CI)
 """
 
 from __future__ import annotations
 
+import glob
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
+
+
+#: The isolated installs: the kernel and one plugin distribution, each Python with the lowest or
+#: the highest sibling versions their ranges allow.
+ISOLATED = (("3.10", "lowest"), ("3.13", "highest"))
+ISOLATED_PACKAGES = ("easynav-core", "easynav-planners")
+
+
+def find_python(version: str) -> str | None:
+    """An interpreter of ``version`` (``3.10``): on PATH, or installed by pyenv."""
+    candidates = [shutil.which(f"python{version}")]
+    root = os.environ.get("PYENV_ROOT", os.path.expanduser("~/.pyenv"))
+    candidates += sorted(glob.glob(f"{root}/versions/{version}.*/bin/python{version}"))
+    for candidate in filter(None, candidates):
+        probe = subprocess.run([candidate, "-c", "import sys; print(sys.version_info[:2])"],
+                               capture_output=True, text=True)
+        wanted = str(tuple(int(part) for part in version.split(".")))
+        if probe.returncode == 0 and probe.stdout.strip() == wanted:
+            return candidate
+    return None
+
+
+def isolated_installs(workers: str) -> int:
+    """The kernel and a plugin distribution alone, on the oldest and the newest Python."""
+    for version, siblings in ISOLATED:
+        python = find_python(version)
+        if python is None:
+            message = f"Python {version} not found: the isolated install on it did not run"
+            print(message, flush=True)
+            if os.environ.get("CI"):
+                return 1
+            continue
+        print(f"== isolated install of {', '.join(ISOLATED_PACKAGES)} on Python {version} "
+              f"({siblings} sibling versions)", flush=True)
+        result = subprocess.run(
+            [sys.executable, str(ROOT / "tools" / "release.py"), "isolated", *ISOLATED_PACKAGES,
+             "--python", python, "--siblings", siblings, "--",
+             "-q", "-m", "not slow", "-n", workers],
+            cwd=ROOT,
+        )
+        if result.returncode != 0:
+            return result.returncode
+    return 0
 
 
 def main(argv: list[str]) -> int:
@@ -23,6 +70,9 @@ def main(argv: list[str]) -> int:
     if lint.returncode != 0:
         print("ruff check failed", flush=True)
         return lint.returncode
+    check = subprocess.run([sys.executable, str(ROOT / "tools" / "release.py"), "check"], cwd=ROOT)
+    if check.returncode != 0:
+        return check.returncode
     workers = os.environ.get("EASYNAV_TEST_WORKERS", "2")
     cmd = [sys.executable, "-m", "pytest", "-n", workers, "--dist", "loadgroup"]
     if fast:
@@ -33,7 +83,9 @@ def main(argv: list[str]) -> int:
     if result.returncode == 5:  # pytest: no tests collected
         print("no tests were collected", flush=True)
         return 1
-    return result.returncode
+    if result.returncode != 0 or fast:
+        return result.returncode
+    return isolated_installs(workers)
 
 
 if __name__ == "__main__":

@@ -52,7 +52,8 @@ WORLDS = ("home", "tb3_sandbox", "depot")
 
 @dataclass(frozen=True)
 class Combination:
-    """One plugin of each axis and a world."""
+    """One plugin of each axis and a world. ``maps_manager`` may be a stack: a maps manager
+    and one that works on its map (``a+b``, e.g. the costmap and the routes on it)."""
 
     maps_manager: str
     localizer: str
@@ -61,8 +62,12 @@ class Combination:
     world: str
 
     @property
-    def plugins(self) -> tuple[str, str, str, str]:
-        return (self.maps_manager, self.localizer, self.planner, self.controller)
+    def maps_managers(self) -> tuple[str, ...]:
+        return tuple(self.maps_manager.split("+"))
+
+    @property
+    def plugins(self) -> tuple[str, ...]:
+        return (*self.maps_managers, self.localizer, self.planner, self.controller)
 
     @property
     def name(self) -> str:
@@ -108,11 +113,24 @@ def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
     classes = {
         (kind, name): plugin_class(kind, name) for kind, names in plugins.items() for name in names
     }
+    # Maps stacks: each maps manager that needs no map, alone and with each one that works on
+    # what it provides (the routes manager on the costmap).
+    stacks: list[tuple[str, ...]] = []
+    for base in plugins["maps manager"]:
+        base_cls = classes[("maps manager", base)]
+        if needed_maps(base_cls):
+            continue
+        stacks.append((base,))
+        for extra in plugins["maps manager"]:
+            needs = needed_maps(classes[("maps manager", extra)])
+            if needs and compatible(needs, provided_maps(base_cls)):
+                stacks.append((base, extra))
     combos = []
-    for maps, loc, plan, ctrl in itertools.product(
-        plugins["maps manager"], plugins["localizer"], plugins["planner"], plugins["controller"]
+    for stack, loc, plan, ctrl in itertools.product(
+        stacks, plugins["localizer"], plugins["planner"], plugins["controller"]
     ):
-        provides = provided_maps(classes[("maps manager", maps)])
+        provides = {rep for m in stack for rep in provided_maps(classes[("maps manager", m)])}
+        maps = "+".join(stack)
         if not all(
             compatible(needed_maps(classes[(kind, name)]), provides)
             for kind, name in (("localizer", loc), ("planner", plan), ("controller", ctrl))
@@ -128,6 +146,7 @@ def covering_slice(combos: list[Combination]) -> list[Combination]:
     by_plugins: dict[tuple[str, ...], list[Combination]] = {}
     for combo in combos:
         by_plugins.setdefault(combo.plugins, []).append(combo)
+    # Each world in turn, so the slice also drives in every world.
     uncovered = {p for combo in combos for p in combo.plugins}
     chosen: list[Combination] = []
     while uncovered:
@@ -168,14 +187,16 @@ def compose_params(combo: Combination, sections: dict[str, dict] | None = None) 
     run reports late RT cycles."""
     sections = representative_sections() if sections is None else sections
     document = load_ros_yaml(BASE_PARAMS.read_text())
-    for (node, types_key, _), plugin in zip(AXES, combo.plugins, strict=True):
+    chosen = (combo.maps_managers, (combo.localizer,), (combo.planner,), (combo.controller,))
+    for (node, types_key, _), plugins in zip(AXES, chosen, strict=True):
         params = document.setdefault(node, {}).setdefault("ros__parameters", {})
         for alias in params.get(types_key) or []:
             params.pop(alias, None)
-        known = sections.get(plugin)
-        section = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
-        params[types_key] = ["matrix"]
-        params["matrix"] = section
+        aliases = [f"matrix{i or ''}" for i in range(len(plugins))]
+        params[types_key] = aliases
+        for alias, plugin in zip(aliases, plugins, strict=True):
+            known = sections.get(plugin)
+            params[alias] = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
     system = document.setdefault("system_node", {}).setdefault("ros__parameters", {})
     system.setdefault("safety", {}).setdefault("heartbeat", {})["period"] = 0.5
     return document

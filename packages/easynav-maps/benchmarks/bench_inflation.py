@@ -13,8 +13,10 @@ Nav2's own inflation benchmark case. Measured, on the same input in the same run
   cached and live obstacles in a 4 m × 4 m window, against a full re-inflation.
 
 OpenCV runs on one thread (``cv2.setNumThreads(1)``). The results of both are checked equal
-before timing. No timing is asserted anywhere; ``--json`` writes the rows of the project's
-benchmark convention (``easynav.core.benchmarking``).
+before timing. The goal row is the CPU time of this single-threaded process (the machine is
+shared: wall time measures the neighbours too); wall-clock rows are shown beside it. No timing
+is asserted anywhere; ``--json`` writes the rows of the project's benchmark convention
+(``easynav.core.benchmarking``).
 """
 
 from __future__ import annotations
@@ -64,14 +66,21 @@ def scipy_inflate(data: np.ndarray) -> np.ndarray:
     return combine_costs(data, costs.astype(np.uint8))
 
 
-def timings(fn, repeats: int) -> tuple[float, float]:
-    samples = []
+def timings(fn, repeats: int) -> tuple[float, float, float]:
+    """Wall-clock p50 and p99 and CPU-time p50 (ms). On a shared, loaded machine the CPU time
+    of this (single-threaded) process is the fairer measure of the work; both are shown."""
+    wall, cpu = [], []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         fn()
-        samples.append((time.perf_counter() - start) * 1e3)
-    samples.sort()
-    return statistics.median(samples), samples[min(len(samples) - 1, int(0.99 * len(samples)))]
+        cpu.append((time.process_time() - start_cpu) * 1e3)
+        wall.append((time.perf_counter() - start) * 1e3)
+    wall.sort()
+    return (
+        statistics.median(wall),
+        wall[min(len(wall) - 1, int(0.99 * len(wall)))],
+        statistics.median(cpu),
+    )
 
 
 def filter_cycle_setup(data: np.ndarray):
@@ -116,29 +125,35 @@ def main() -> None:
         raise SystemExit("inflate and the scipy reference disagree: not timing wrong results")
     cycle = filter_cycle_setup(data)
     cycle()  # inflates and caches the base
-    p50, p99 = timings(lambda: inflate(data, RESOLUTION, RADIUS, INSCRIBED, K), args.repeats)
-    ref50, ref99 = timings(lambda: scipy_inflate(data), max(3, args.repeats // 3))
-    cv50, _ = timings(
-        lambda: opencv_inflate(data), max(3, args.repeats // 3)
+    p50, p99, cpu50 = timings(
+        lambda: inflate(data, RESOLUTION, RADIUS, INSCRIBED, K), args.repeats
     )
-    c50, _ = timings(cycle, args.repeats)
+    ref50, ref99, ref_cpu50 = timings(lambda: scipy_inflate(data), max(3, args.repeats // 3))
+    cv50, _, cv_cpu50 = timings(lambda: opencv_inflate(data), max(3, args.repeats // 3))
+    c50, _, c_cpu50 = timings(cycle, args.repeats)
     path = "numba" if compiled() else "OpenCV (numba not installed)"
     rows = [
         BenchRow(
-            f"inflate 2000x2000, 50% lethal, 2 m radius, one core, p50 [{path}]", p50, "ms",
-            "scipy.ndimage.distance_transform_edt + the formula, p50", ref50,
+            f"inflate 2000x2000, 50% lethal, 2 m radius, one core, CPU p50 [{path}]", cpu50,
+            "ms", "scipy.ndimage.distance_transform_edt + the formula, CPU p50", ref_cpu50,
+            goal="<= 25 ms", met=cpu50 <= 25.0,
+        ),
+        BenchRow(
+            "inflate 2000x2000, wall p50", p50, "ms", "scipy reference, wall p50", ref50,
             goal="<= 25 ms", met=p50 <= 25.0,
         ),
-        BenchRow("inflate 2000x2000, p99", p99, "ms", "scipy reference, p99", ref99),
+        BenchRow("inflate 2000x2000, wall p99", p99, "ms", "scipy reference, wall p99", ref99),
         BenchRow(
-            "inflate 2000x2000, OpenCV path (no numba), p50", cv50, "ms",
-            "scipy reference, p50", ref50,
+            "inflate 2000x2000, OpenCV path (no numba), CPU p50", cv_cpu50, "ms",
+            "scipy reference, CPU p50", ref_cpu50,
         ),
         BenchRow(
-            "InflationFilter cycle, base cached, obstacles in a 4 m x 4 m window, p50", c50,
-            "ms", "full inflation (inflate), p50", p50, goal="< full inflation", met=c50 < p50,
+            "InflationFilter cycle, base cached, obstacles in a 4 m x 4 m window, CPU p50",
+            c_cpu50, "ms", "full inflation (inflate), CPU p50", cpu50,
+            goal="< full inflation", met=c_cpu50 < cpu50,
         ),
     ]
+    del c50, cv50
     report(rows, args.json)
 
 

@@ -283,3 +283,51 @@ def test_real_map_with_filters_runs(tmp_path):
     live = nav_state.get(MAP)
     assert math.isclose(live.resolution, 0.05)
     assert (live.data == 253).sum() > (manager.base_map.data == 254).sum()
+
+
+def test_a_newer_laser_scan_clears_what_an_older_camera_frame_saw(tmp_path):
+    params = {"map_path_file": str(room_yaml(tmp_path, size=100))}
+    params.update(filters(("obstacles", OBSTACLES)))  # persistence 0: the original's memory
+    manager = make_manager(params)
+    laser_at(manager, 1.0, 2.5)
+    ts = TransformStamped(
+        Header(0.0, "map"), "camera", Transform(np.array([1.0, 2.5, 0.5]), np.array([0, 0, 0, 1.0]))
+    )
+    get_tf_buffer(manager.context.namespace).set_transform(ts, "test", is_static=True)
+    nav_state = NavState()
+    # The slow camera still holds a frame (stamp 9.0) with the person 1 m ahead ...
+    nav_state.set("camera", PointPerception(np.array([[1.0, 0.0, -0.2]]), "camera", 9.0))
+    manager.update(nav_state)
+    assert nav_state.get(MAP).cost_at(2.0, 2.5) == 254
+    # ... the laser's newer scan (stamp 9.5) sees the wall 2 m ahead through that spot.
+    nav_state.set("laser", PointPerception(np.array([[2.0, 0.0, 0.0]]), "laser", 9.5))
+    manager.update(nav_state)
+    live = nav_state.get(MAP)
+    assert live.cost_at(2.0, 2.5) == 0 and live.cost_at(3.0, 2.5) == 254
+    # Without clearing, the camera's old point stays an obstacle.
+    manager.apply_parameter("obstacles.clearing", False)
+    manager.update(nav_state)
+    assert nav_state.get(MAP).cost_at(2.0, 2.5) == 254
+
+
+def test_bounds_to_window_grows_and_clamps():
+    from easynav.maps.costmap.inflation_filter import bounds_to_window
+
+    grid = Costmap2D.filled(10, 8, 0.5, origin_x=-1.0, origin_y=-1.0)
+    assert bounds_to_window(grid, (0.1, 0.1, 0.6, 0.6), 1) == (1, 1, 5, 5)
+    assert bounds_to_window(grid, (-9.0, -9.0, 99.0, 99.0), 2) == (0, 0, 10, 8)
+    assert bounds_to_window(grid, (50.0, 50.0, 60.0, 60.0), 1) is None
+
+
+def test_inflation_filter_alone_inflates_the_whole_map():
+    from easynav.maps.costmap.inflation_filter import InflationFilter
+
+    inflation = InflationFilter()
+    inflation.initialize(
+        PluginContext(parameters=DictParameters({"i.inflation_radius": 0.5})), "i"
+    )
+    costmap = Costmap2D.filled(20, 20, 0.1)
+    costmap.data[10, 10] = 254
+    expected = inflate(costmap.data, 0.1, 0.5, 0.3, 3.0)
+    inflation.update(NavState(), costmap)  # no map.base: nothing cached, all inflated
+    assert np.array_equal(costmap.data, expected)

@@ -160,3 +160,34 @@ def test_set_routes_and_runtime_min_cost(tmp_path):
     m.update(nav_state)
     data = nav_state.get(MAP).data
     assert (data[5] == 0).all() and (np.delete(data, 5, axis=0) == 80).all()
+
+
+def test_after_the_costmap_manager_in_map_types(tmp_path):
+    """The order the original needs: the costmap manager rebuilds map, the routes steer it."""
+    import cv2
+
+    from easynav.maps.costmap.costmap_maps_manager import CostmapMapsManager
+
+    cv2.imwrite(str(tmp_path / "m.pgm"), np.full((20, 30), 254, np.uint8))
+    (tmp_path / "m.yaml").write_text(
+        "image: m.pgm\nresolution: 0.1\norigin: [-0.5, -0.5, 0.0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    (tmp_path / "routes.yaml").write_text(ROUTES_YAML)
+    params = {
+        "costmap.map_path_file": str(tmp_path / "m.yaml"),
+        "routes.map_path_file": str(tmp_path / "routes.yaml"),
+        "routes.filters": ["costmap"],
+        "routes.costmap.plugin": FILTER,
+    }
+    context = PluginContext(parameters=DictParameters(params), namespace="routes_chain")
+    costmap_manager, routes_manager = CostmapMapsManager(), RoutesMapsManager()
+    costmap_manager.initialize(context, "costmap")
+    routes_manager.initialize(context, "routes")
+    nav_state = NavState()
+    for _ in range(2):  # every cycle: rebuilt, then steered (no accumulation)
+        costmap_manager.update(nav_state)
+        routes_manager.update(nav_state)
+        result = nav_state.get(MAP)
+        assert result.cost_at(0.55, 0.05) == 0 and result.cost_at(0.55, 0.45) == 50
+        assert (nav_state.get("map.base").data == 0).all()

@@ -15,7 +15,7 @@ import numpy as np
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext, RecoveryActions
-from easynav.core.robot import RobotGeometry
+from easynav.core.robot import RobotGeometry, RobotLimits
 from easynav.core.sensors import PointPerception
 from easynav.core.types import (
     Goals,
@@ -104,10 +104,16 @@ def make_context(
     actions: RecoveryActions | None = None,
     geometry: RobotGeometry | None = None,
     namespace: str | None = None,
+    limits: Any = None,
 ) -> PluginContext:
-    """A plugin context without ROS, in a TF namespace of its own (isolated TF buffer)."""
+    """A plugin context without ROS, in a TF namespace of its own (isolated TF buffer).
+    ``limits``: the robot limits in force, a RobotLimits or a callable returning them (the
+    defaults when None)."""
     geometry = geometry or RobotGeometry()
+    if limits is None:
+        limits = RobotLimits()
     return PluginContext(
+        robot_limits=limits if callable(limits) else (lambda: limits),
         parameters=DictParameters(params or {}),
         node=None,
         node_name="recovery_node",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from recovery_harness import (
     Clock,
@@ -18,7 +19,16 @@ from recovery_harness import (
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
-from easynav.core.types import DiagnosticLevel, DiagnosticStatus, SafetyChannelState, Twist
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import (
+    DiagnosticLevel,
+    DiagnosticStatus,
+    Header,
+    SafetyChannelState,
+    Transform,
+    TransformStamped,
+    Twist,
+)
 from easynav.recovery.diagnostic.evaluators import (
     AmclConvergenceEvaluator,
     ControllerStuckEvaluator,
@@ -159,6 +169,46 @@ def test_an_error_stays_while_a_mitigation_controls_until_the_robot_moves():
     assert bench.run(0.1).level == OK
     bench.nav_state.set("control_owner", "controller")
     assert bench.level_after(1.5) == OK  # a new window
+
+
+def set_odometry(bench: Bench, x: float, y: float = 0.0) -> None:
+    """The driver's odometry: ``odom → base_footprint`` in the evaluator's TF buffer, now."""
+    buffer = get_tf_buffer(bench.evaluator.context.namespace)
+    buffer.set_transform(
+        TransformStamped(
+            Header(bench.clock.t, "odom"), "base_footprint", Transform(np.array([x, y, 0.0]))
+        ),
+        "driver",
+    )
+
+
+def test_a_held_robot_is_stuck_even_when_the_localisation_drifts():
+    # Held in place: the wheels (odometry) do not move, the localisation drifts 0.1 m/s (more
+    # than the progress threshold over the window).
+    bench = stuck_bench()
+    for i in range(30):
+        set_odometry(bench, 1.0)
+        set_pose(bench.nav_state, 0.01 * i, 0.0)
+        status = bench.run(0.1)
+    assert status.level == ERROR, status.message
+    assert "moved less than" in status.message
+
+
+def test_progress_is_the_distance_driven_by_odometry():
+    # The localisation is stuck at one pose (e.g. it lost track), the wheels drive on: progress.
+    bench = stuck_bench()
+    for i in range(40):
+        set_odometry(bench, 0.02 * i)
+        assert bench.run(0.1).level == OK
+    # Odometry stops: stuck after the window, whatever robot_pose does.
+    for i in range(25):
+        set_odometry(bench, 0.78)
+        set_pose(bench.nav_state, 0.3 * i, 0.0)
+        status = bench.run(0.1)
+    assert status.level == ERROR
+    # The wheels turn again: OK at once.
+    set_odometry(bench, 1.2)
+    assert bench.run(0.1).level == OK
 
 
 # ── ObstacleTooCloseEvaluator ────────────────────────────────────────────────────────────────

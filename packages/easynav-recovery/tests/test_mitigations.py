@@ -15,6 +15,7 @@ from recovery_harness import (
 
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
+from easynav.core.robot import RobotLimits
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Twist
 from easynav.recovery.diagnostic import RecoveryStatus
 from easynav.recovery.diagnostic.mitigations import (
@@ -36,12 +37,16 @@ def status(hardware_id: str, level=ERROR, name="recovery_manager.x", message="ba
 
 
 class Bench:
-    def __init__(self, cls, params=None, alias="recovery_manager.m") -> None:
+    def __init__(self, cls, params=None, alias="recovery_manager.m", limits=None) -> None:
         self.nav_state = NavState()
         self.clock = Clock()
         self.actions = RecordingActions(self.nav_state)
+        self.limits = limits or RobotLimits()
         context = make_context(
-            {f"{alias}.{k}": v for k, v in (params or {}).items()}, self.clock, self.actions
+            {f"{alias}.{k}": v for k, v in (params or {}).items()},
+            self.clock,
+            self.actions,
+            limits=lambda: self.limits,
         )
         self.slot = TakeoverSlot(clock=self.clock)
         self.reports: list[tuple[int, str]] = []
@@ -108,6 +113,32 @@ def test_safe_retreat_tries_the_other_way_for_an_obstacle_beside():
     bench.start()
     assert bench.cycle() is RUNNING
     assert bench.command() == Twist(vx=-0.15)
+
+
+def test_safe_retreat_never_sends_a_robot_that_cannot_reverse_backwards():
+    no_reverse = RobotLimits(min_linear_vel=0.0)
+    bench = Bench(SafeRetreatRecovery, limits=no_reverse)
+    bench.nav_state.set("laser1", scan([(0.45, 0.0, 0.2)]))  # ahead: backwards is the way
+    bench.start()
+    assert bench.cycle() is FAILED
+    assert bench.command() == Twist()
+    assert not any(t.vx < 0.0 for t in bench.actions.of("command_velocity"))
+    assert "robot_limits.min_linear_vel = 0" in bench.reports[-1][1]
+    # Beside: forward is still a way out for it.
+    beside = Bench(SafeRetreatRecovery, limits=no_reverse)
+    beside.nav_state.set("laser1", scan([(0.05, 0.42, 0.2)]))
+    beside.start()
+    assert beside.cycle() is RUNNING and beside.command() == Twist(vx=0.15)
+
+
+def test_safe_retreat_keeps_to_the_limits_in_force():
+    bench = Bench(SafeRetreatRecovery, limits=RobotLimits(min_linear_vel=-0.1))
+    bench.nav_state.set("laser1", scan([(0.45, 0.0, 0.2)]))
+    bench.start()
+    assert bench.cycle() is RUNNING and bench.command() == Twist(vx=-0.1)
+    # Reversing forbidden while retreating (a runtime change): it stops and fails.
+    bench.limits = RobotLimits(min_linear_vel=0.0)
+    assert bench.cycle() is FAILED and bench.command() == Twist()
 
 
 # ── AdvanceRecovery ──────────────────────────────────────────────────────────────────────────

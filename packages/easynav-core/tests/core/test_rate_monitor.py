@@ -60,6 +60,21 @@ def test_time_without_checks_counts_as_slow_but_restart_forgets_it():
     assert statuses and statuses[-1][1].level == DiagnosticLevel.OK
 
 
+def test_restart_clears_a_standing_warn():
+    # Slow before a deactivation: the WARN must not stand through the next activation until a
+    # whole window has been measured.
+    monitor = RateMonitor("dummy.rate", 10.0, "planner_node", "dummy.freq")
+    statuses = feed(monitor, 2.0, 0.0, 3.0)
+    assert statuses[-1][1].level == DiagnosticLevel.WARN
+    monitor.restart()
+    status = monitor.check(100.0)
+    assert status is not None and status.level == DiagnosticLevel.OK
+    assert status.message == "measuring"
+    # A restart with nothing standing writes nothing new.
+    monitor.restart()
+    assert monitor.check(200.0) is None
+
+
 def test_window_is_one_second_or_ten_periods():
     assert RateMonitor("a", 30.0, "n", "p").window == 1.0
     assert RateMonitor("b", 1.0, "n", "p").window == 10.0

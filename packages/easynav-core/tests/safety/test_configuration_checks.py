@@ -149,6 +149,26 @@ def test_a_plugin_faster_than_its_system_cycle_fails():
     assert "system_node/freq" in errors(with_value("localizer_node", "loc.freq", 201.0))[0]
 
 
+def test_only_frequencies_in_use_are_checked_when_known():
+    params = valid_parameters()
+    # A default every plugin declares, of a part the plugin does not have (or a plugin no
+    # longer loaded): above the cycle's frequency, but it schedules nothing.
+    params["controller_node"]["ctrl.freq"] = 500.0
+    params["localizer_node"]["loc.rt_freq"] = 300.0
+    in_use = {("controller_node", "ctrl.rt_freq"), ("localizer_node", "loc.freq")}
+    found = configuration_errors(
+        params, 30.0, sched_fifo_trial=allowed, memlock_check=allowed, frequencies_in_use=in_use
+    )
+    assert found == []
+    in_use.add(("localizer_node", "loc.rt_freq"))
+    found = configuration_errors(
+        params, 30.0, sched_fifo_trial=allowed, memlock_check=allowed, frequencies_in_use=in_use
+    )
+    assert len(found) == 1 and "localizer_node/loc.rt_freq = 300 Hz exceeds" in found[0]
+    # Without the set (a params file alone), every frequency is checked.
+    assert len(errors(params)) == 2
+
+
 def test_reseed_freq_and_similar_names_are_not_cycle_frequencies():
     assert errors(with_value("localizer_node", "loc.reseed_freq", 1000.0)) == []
 

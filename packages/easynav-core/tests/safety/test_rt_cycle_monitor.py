@@ -33,14 +33,26 @@ def test_a_late_cycle_is_warn_and_an_on_time_cycle_ok_again():
     assert monitor.status == RT_OK and monitor.late_cycles == 1
 
 
-def test_max_late_cycles_in_a_row_is_error():
-    monitor = RTCycleMonitor(200.0, max_period_factor=2.0, max_late_cycles=3)
+def test_max_late_cycles_in_a_row_is_error_in_safety_mode():
+    monitor = RTCycleMonitor(200.0, max_period_factor=2.0, max_late_cycles=3, safety_mode=True)
     changes = run(monitor, [0.02, 0.02])  # cycles at 100.00, 100.02, 100.04
     assert monitor.status == RT_LATE and not monitor.is_error
     changes.append(monitor.on_cycle_start(100.06))  # the third late one in a row
     assert monitor.status == RT_ERROR and monitor.is_error
     assert [c.level for c in changes] == [DiagnosticLevel.WARN, DiagnosticLevel.ERROR]
     assert "3 real-time cycles in a row" in changes[-1].message
+
+
+def test_outside_safety_mode_late_cycles_in_a_row_are_only_a_warn():
+    # seed-design "Real-time cycle monitoring": outside safety mode a late RT cycle is only a
+    # WARN; the status (heartbeat rt_status) still says ERROR and the message counts them.
+    monitor = RTCycleMonitor(200.0, max_period_factor=2.0, max_late_cycles=3)
+    changes = run(monitor, [0.02, 0.02, 0.02, 0.02])
+    assert monitor.status == RT_ERROR and monitor.is_error
+    assert [c.level for c in changes] == [DiagnosticLevel.WARN, DiagnosticLevel.WARN]
+    assert "3 real-time cycles in a row" in changes[-1].message
+    changes = run(monitor, [PERIOD], start=100.08)
+    assert [c.level for c in changes] == [DiagnosticLevel.OK]
 
 
 def test_isolated_late_cycles_never_add_up_to_an_error():

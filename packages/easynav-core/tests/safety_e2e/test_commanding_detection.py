@@ -89,16 +89,17 @@ def test_blocked_rt_cycle_stops_heartbeats_fires_the_deadline_and_is_reported(ro
     blocked_at = time.monotonic()
     injector(rt).fault = "hang"  # every controller update now blocks HANG_TIME
     assert ros.spin_until(lambda: receiver.events.deadline_missed_after(blocked_at), timeout=3.0)
-    # The RT monitor sees the late cycles: WARN, then ERROR after max_late_cycles in a row;
-    # the heartbeats that still get out say so.
-    assert ros.spin_until(lambda: rt_cycle_level(rt) == DiagnosticLevel.ERROR, timeout=5.0)
+    # The RT monitor sees the late cycles: LATE, then ERROR after max_late_cycles in a row;
+    # the heartbeats that still get out say so. Outside safety mode the diagnostic is only a
+    # WARN (seed-design, "Real-time cycle monitoring").
     assert ros.spin_until(
-        lambda: any(m.rt_status == RT_ERROR for m in receiver.received_after(blocked_at)), 3.0
+        lambda: any(m.rt_status == RT_ERROR for m in receiver.received_after(blocked_at)), 5.0
     )
     late = receiver.received_after(blocked_at)
     assert any(m.rt_status == RT_LATE for m in late) and late[-1].late_cycles >= 2
     status = rt.nav_state.get("diagnostics.rt_cycle")
     assert status.hardware_id == "system_node"
+    assert status.level == DiagnosticLevel.WARN and "in a row" in status.message, status
     # Outside safety mode it is only reported.
     assert rt.requests.shutdown_reason is None
     assert rt.system_node.lifecycle_state() == "active"

@@ -55,6 +55,28 @@ def test_non_rt_frequency_checked_against_system_freq(params_file, runtime_facto
     assert "dummy.freq" in rt.error and "system_node.freq" in rt.error
 
 
+def test_only_frequencies_in_use_are_checked_against_the_system_cycles(
+    params_file, runtime_factory
+):
+    # A 5 Hz non-RT cycle: the controller has no non-RT part, so its freq (a default of 10 Hz
+    # every plugin declares) schedules nothing and is no error, neither when the plugin loads nor
+    # in the configuration checks of the safety supervisor.
+    document = system_params(
+        **{
+            "system_node.freq": 5.0,
+            "maps_manager_node.dummy.freq": 5.0,
+            "recovery_node.recovery_manager.freq": 5.0,
+        }
+    )
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    in_use = rt.system_node.system.frequencies_in_use
+    assert ("controller_node", "dummy.rt_freq") in in_use
+    assert ("controller_node", "dummy.freq") not in in_use
+    assert ("planner_node", "dummy.freq") in in_use
+    assert ("planner_node", "dummy.rt_freq") not in in_use
+
+
 @pytest.mark.parametrize("value", [0.0, -5.0, float("nan"), float("inf")])
 def test_frequency_must_be_finite_and_positive(params_file, runtime_factory, value):
     document = system_params(**{"planner_node.dummy.freq": value})
@@ -133,7 +155,7 @@ def test_slow_rt_component_makes_its_rate_diagnostic_warn(params_file, runtime_f
 
     assert wait_for(warned, timeout=6.0)
     status = rt.nav_state.get(key)
-    assert "dummy.rt_freq" in status.message
+    assert "controller_node.dummy.rt_freq" in status.message
     # Only ever a WARN: the other components are not reported.
     other = rt.nav_state.get("diagnostics.planner_node.dummy.rate")
     assert other.level == DiagnosticLevel.OK
@@ -150,3 +172,39 @@ def test_unique_aliases_keep_the_plain_diagnostic_name(params_file, runtime_fact
     rt = runtime_factory(params_file(document))
     assert rt.start(), rt.error
     assert wait_for(lambda: rt.nav_state.has("diagnostics.ctrl.rt_rate"))
+
+
+def test_the_seeds_shared_alias_gives_every_node_its_own_rate_keys(params_file, runtime_factory):
+    # The seed's simple.params.yaml calls the plugin of every node "simple".
+    nodes = {
+        "controller_node": ("controller_types", "easynav_controller/DummyController"),
+        "localizer_node": ("localizer_types", "easynav_localizer/DummyLocalizer"),
+        "maps_manager_node": ("map_types", "easynav_maps_manager/DummyMapsManager"),
+        "planner_node": ("planner_types", "easynav_planner/DummyPlanner"),
+    }
+    overrides = {}
+    for node, (types, plugin) in nodes.items():
+        overrides[f"{node}.{types}"] = ["simple"]
+        overrides[f"{node}.dummy"] = None
+        overrides[f"{node}.simple"] = {"plugin": plugin, "rt_freq": 20.0, "freq": 1.0}
+    rt = runtime_factory(params_file(system_params(**overrides)))
+    assert rt.start(), rt.error
+    expected = {
+        "diagnostics.controller_node.simple.rt_rate",
+        "diagnostics.localizer_node.simple.rt_rate",
+        "diagnostics.localizer_node.simple.rate",
+        "diagnostics.maps_manager_node.simple.rate",
+        "diagnostics.planner_node.simple.rate",
+    }
+
+    def rate_keys():
+        return {
+            k for k in rt.nav_state.keys() if k.endswith(".rate") or k.endswith(".rt_rate")
+        }
+
+    assert wait_for(lambda: rate_keys() == expected, timeout=5.0), rate_keys()
+    for key in expected:
+        status = rt.nav_state.get(key)
+        node = key.split(".")[1]
+        assert status.hardware_id == node
+        assert status.values["expected_hz"] in ("20", "1")

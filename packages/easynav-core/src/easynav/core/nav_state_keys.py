@@ -82,3 +82,10 @@ RECONFIGURED_PARAMETERS = NavStateKey(
     "list[str]",
     "``node/parameter`` changed through ``request_reconfigure``.",
 )
+
+SPEED_LIMIT = NavStateKey(
+    "speed_limit",
+    "float",
+    "the speed zone's limit at the robot's position, a fraction (0, 1] of the limits in force "
+    "(1.0: no zone); the velocity output cuts the linear and angular limits by it (SpeedFilter).",
+)

@@ -86,14 +86,17 @@ class AMCLLocalizer(LocalizerMethodBase):
     the robot footprint frame, stamp of the odometry used, covariance of the particles, twist of
     the odometry) and ``localizer.amcl.covariance_trace`` (float: var x + var y + var yaw).
 
-    ROS (when hosted by a node): subscribes ``odom`` (nav_msgs/Odometry) and ``initialpose``
-    (geometry_msgs/PoseWithCovarianceStamped, map frame or empty: resets the cloud); publishes
+    ROS (when hosted by a node): subscribes ``odom`` (nav_msgs/Odometry) on the host's RT-side
+    node (``context.rt_node``, spun by the RT loop like the original's RT callback group: a slow
+    non-RT loop cannot delay the prediction; the host node without one); ``initialpose``
+    (through :class:`LocalizerMethodBase`) resets the cloud (:meth:`on_initial_pose`); publishes
     ``<fqn>/<alias>/particles`` (PoseArray) and ``<fqn>/<alias>/pose``
     (PoseWithCovarianceStamped) after each correction while subscribed; broadcasts ``map → odom``
     on ``tf`` (and into this process's TF buffer, also without a node).
 
-    Thread contract: ``update_rt`` in the RT thread; ``update``, the ROS callbacks,
-    :meth:`set_odometry`, :meth:`reset_pose` and ``on_last_known_pose`` from the non-RT side.
+    Thread contract: ``update_rt`` and the ``odom`` callback in the RT thread; ``update``,
+    ``initialpose``, :meth:`reset_pose` and ``on_last_known_pose`` from the non-RT side;
+    :meth:`set_odometry` from any thread.
     One lock guards the particles; the expensive scoring runs outside it on a snapshot.
     Exceptions: :class:`PluginConfigurationError` naming the parameter.
     """
@@ -110,6 +113,7 @@ class AMCLLocalizer(LocalizerMethodBase):
         self._odom_used_stamp: float | None = None
         self._last_reseed = 0.0
         self._ros: dict = {}
+        self._odom_node = None  # where the odom subscription lives (RT-side node or host)
         self._broadcaster = None
         self._field_map: SimpleMap | None = None
         self._field: np.ndarray | None = None
@@ -215,6 +219,12 @@ class AMCLLocalizer(LocalizerMethodBase):
 
     def on_last_known_pose(self, pose: Odometry) -> None:
         """Continue from the pose left by the previous localizer (any type)."""
+        cov = np.asarray(pose.pose_covariance, dtype=float).reshape(6, 6)
+        self.reset_pose(pose.pose.x, pose.pose.y, pose.pose.yaw, cov[:2, :2], cov[5, 5])
+
+    def on_initial_pose(self, pose: Odometry) -> None:
+        """``initialpose`` (checked by the base): redraw the cloud from the message's
+        covariance, with the ``min_noise_*`` floors (the original's)."""
         cov = np.asarray(pose.pose_covariance, dtype=float).reshape(6, 6)
         self.reset_pose(pose.pose.x, pose.pose.y, pose.pose.yaw, cov[:2, :2], cov[5, 5])
 
@@ -386,11 +396,11 @@ class AMCLLocalizer(LocalizerMethodBase):
             reliability=ReliabilityPolicy.RELIABLE,
             durability=DurabilityPolicy.VOLATILE,
         )
+        # Odometry feeds the RT prediction: served by the RT loop's executor when there is one.
+        odom_node = self.context.rt_node if self.context.rt_node is not None else node
+        self._odom_node = odom_node
         self._ros = {
-            "odom": node.create_subscription(OdometryMsg, "odom", self._on_odom, odom_qos),
-            "initialpose": node.create_subscription(
-                PoseWithCovarianceStamped, "initialpose", self._on_initial_pose, 10
-            ),
+            "odom": odom_node.create_subscription(OdometryMsg, "odom", self._on_odom, odom_qos),
             "particles": node.create_publisher(PoseArray, f"{base}/particles", 10),
             "pose": node.create_publisher(PoseWithCovarianceStamped, f"{base}/pose", 10),
         }
@@ -403,8 +413,8 @@ class AMCLLocalizer(LocalizerMethodBase):
         if node is None:
             return
         for name, entity in ros.items():
-            if name in ("odom", "initialpose"):
-                node.destroy_subscription(entity)
+            if name == "odom":
+                self._odom_node.destroy_subscription(entity)
             else:
                 node.destroy_publisher(entity)
         if broadcaster is not None:
@@ -414,24 +424,3 @@ class AMCLLocalizer(LocalizerMethodBase):
         from easynav.core.ros.converters import odometry_from_msg
 
         self.set_odometry(odometry_from_msg(msg))
-
-    def _on_initial_pose(self, msg) -> None:
-        from easynav.core.ros.converters import pose_from_msg
-
-        map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
-        frame = msg.header.frame_id
-        if frame and frame.lstrip("/") != map_frame:
-            self.logger.warning(
-                f"{self.plugin_name}: initialpose in frame '{frame}' ignored: expected "
-                f"'{map_frame}'"
-            )
-            return
-        pose = pose_from_msg(msg.pose.pose)
-        if not pose.is_finite():
-            self.logger.warning(f"{self.plugin_name}: non-finite initialpose ignored")
-            return
-        cov = np.array(msg.pose.covariance, dtype=float).reshape(6, 6)
-        if not np.all(np.isfinite(cov)):
-            self.logger.warning(f"{self.plugin_name}: initialpose covariance not finite: ignored")
-            return
-        self.reset_pose(pose.x, pose.y, pose.yaw, cov[:2, :2], cov[5, 5])

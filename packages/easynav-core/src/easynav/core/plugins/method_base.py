@@ -36,8 +36,9 @@ class MethodBase:
     :class:`~easynav.core.plugins.declarations.Param`), and reads them as ``self.params.<name>``.
     ``initialize(context, plugin_name)`` declares every parameter on the host node under
     ``<plugin_name>.``, converts and validates it (an error names parameter, value and rule),
-    reads deprecated names with a warning, checks ``rt_freq`` and ``freq`` (10.0 each) against
-    the system cycle's frequencies and calls :meth:`on_initialize`. It may be called again on the
+    reads deprecated names with a warning, checks ``rt_freq`` and ``freq`` (10.0 each) of the
+    parts the plugin has (:meth:`used_frequencies`) against the system cycle's frequencies and
+    calls :meth:`on_initialize`. It may be called again on the
     same object or on a fresh one after a cleanup (runtime reconfiguration).
 
     Thread contract: ``initialize`` runs in the configuring thread while no loop runs; RT methods
@@ -141,6 +142,10 @@ class MethodBase:
             raise PluginConfigurationError(str(exc)) from None
         self.rt_freq = self._check_frequency("rt_freq", self.params.rt_freq)
         self.freq = self._check_frequency("freq", self.params.freq)
+        in_use = context.frequencies_in_use
+        if in_use is not None:
+            for name in self.used_frequencies():
+                in_use.add((context.node_name, f"{plugin_name}.{name}"))
         self.rt_schedule = RateSchedule(self.rt_freq)
         self.schedule = RateSchedule(self.freq)
         self.on_initialize()
@@ -151,14 +156,31 @@ class MethodBase:
     def on_cleanup(self) -> None:
         """Release what ``on_initialize`` created (called on cleanup)."""
 
+    def cleanup(self) -> None:
+        """What hosts call on cleanup: :meth:`on_cleanup`, then what a base class created in
+        ``initialize`` (e.g. a localizer's ``initialpose`` subscription). Configuring thread."""
+        self.on_cleanup()
+
     def on_activate(self) -> None:
         """EasyNav becomes active (its cycles start). Lifecycle thread, loops not cycling."""
 
     def on_deactivate(self) -> None:
         """EasyNav becomes inactive (its cycles stop). Lifecycle thread, loops not cycling."""
 
+    @classmethod
+    def used_frequencies(cls) -> tuple[str, ...]:
+        """The frequency parameters this plugin runs at: ``rt_freq`` with an RT part, ``freq``
+        with a non-RT part. The others are declared (common to every plugin) but unused."""
+        return (("rt_freq",) if cls.HAS_RT_UPDATE else ()) + (
+            ("freq",) if cls.HAS_UPDATE else ()
+        )
+
     def _check_frequency(self, name: str, value: float) -> float:
-        # A plugin cannot run faster than the cycle that schedules it.
+        # A plugin cannot run faster than the cycle that schedules it; a frequency of a part the
+        # plugin does not have schedules nothing (e.g. a planner's rt_freq default of 10 Hz
+        # under a 5 Hz RT cycle) and is not an error.
+        if name not in self.used_frequencies():
+            return value
         system_value, system_name = (
             (self.context.system_rt_freq, "system_node.rt_freq") if name == "rt_freq"
             else (self.context.system_freq, "system_node.freq")

@@ -63,6 +63,11 @@ class PluginContext:
     unit tests): plugins create their debug publishers and subscriptions on it.
     ``now`` returns the node clock in seconds (simulated time with ``use_sim_time``).
     ``robot_limits`` returns the limits in force (cut down by a safely limited speed).
+    ``rt_node`` is a node spun by the RT loop's executor (None without ROS): subscriptions whose
+    data the RT part needs at once (odometry for a prediction) go there, so a slow non-RT loop
+    cannot delay them; their callbacks run in the RT thread and must only store the data.
+    ``frequencies_in_use`` collects ``(node_name, "<plugin_name>.rt_freq|freq")`` of the
+    frequencies the loaded plugins actually use (the configuration checks look only at those).
     """
 
     parameters: ParameterAccess = field(default_factory=DictParameters)
@@ -77,3 +82,5 @@ class PluginContext:
     robot_limits: Callable[[], RobotLimits] = RobotLimits
     # Recovery system actions and other host services, set by the hosts that offer them.
     services: dict[str, Any] = field(default_factory=dict)
+    rt_node: Any = None
+    frequencies_in_use: set[tuple[str, str]] | None = None

@@ -38,13 +38,19 @@ class RateMonitor:
         self._slow_since: float | None = None
         self._level: DiagnosticLevel | None = None
         self._last_message = ""
+        self._restarted = False
 
     def restart(self) -> None:
-        """Start measuring again (after an activation: inactive time is not slowness)."""
+        """Start measuring again (after an activation: inactive time is not slowness).
+
+        A WARN standing from before is cleared: the next check reports OK "measuring" (a
+        component that was slow before a deactivation is not known to be slow now).
+        """
         self._window_start = None
         self._runs = 0
         self._slow_windows = 0
         self._slow_since = None
+        self._restarted = True
 
     def record_run(self) -> None:
         """Count one run of the component."""
@@ -55,7 +61,8 @@ class RateMonitor:
         if self._window_start is None or now < self._window_start:
             self._window_start = now
             self._runs = 0
-            if self._level is None:
+            restarted, self._restarted = self._restarted, False
+            if self._level is None or (restarted and self._level != DiagnosticLevel.OK):
                 return self._emit(DiagnosticLevel.OK, "measuring", 0.0)
             return None
         elapsed = now - self._window_start

@@ -45,6 +45,16 @@ class RobotLimits:
                 errors.append(f"{name} = {value} must be > 0")
         return errors
 
+    def scaled(self, fraction: float) -> RobotLimits:
+        """These limits with the speeds cut to ``fraction`` of theirs (a speed zone).
+
+        A fraction that is not a finite number in (0, 1) changes nothing (1.0 is no zone; a
+        speed zone lowers speeds, it never stops the robot: that is the safety channel's).
+        """
+        if not (math.isfinite(fraction) and 0.0 < fraction < 1.0):
+            return self
+        return self.cut_down(self.max_linear_vel * fraction, self.max_angular_vel * fraction)
+
     def cut_down(self, max_linear: float, max_angular: float) -> RobotLimits:
         """These limits with speeds cut down to a safely limited speed (either direction)."""
         return replace(

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import fields
 
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
@@ -81,7 +81,7 @@ def _robot_limits(check: _Checker) -> dict[str, float | None]:
     return limits
 
 
-def _frequencies(check: _Checker) -> None:
+def _frequencies(check: _Checker, in_use: Collection[tuple[str, str]] | None) -> None:
     system_rt = check.number(SYSTEM, "rt_freq", ">0", " Hz")
     system_nort = check.number(SYSTEM, "freq", ">0", " Hz")
     cycles = {"rt_freq": (system_rt, "rt_freq"), "freq": (system_nort, "freq")}
@@ -92,6 +92,8 @@ def _frequencies(check: _Checker) -> None:
             last = name.rsplit(".", 1)[1]
             if last not in cycles:
                 continue
+            if in_use is not None and (node, name) not in in_use:
+                continue  # declared (a default every plugin has) but scheduling nothing
             value = check.number(node, name, ">0", " Hz")
             system_value, system_name = cycles[last]
             if value is not None and system_value is not None and value > system_value:
@@ -128,6 +130,7 @@ def configuration_errors(
     *,
     sched_fifo_trial: PermissionCheck = try_sched_fifo,
     memlock_check: PermissionCheck = memlock_allowed,
+    frequencies_in_use: Collection[tuple[str, str]] | None = None,
 ) -> list[str]:
     """Every configuration error of seed-safety.txt, each naming its parameter (``node/name``).
 
@@ -139,7 +142,10 @@ def configuration_errors(
     ``controller_node``'s ``controller_types`` and ``<alias>.rt_freq`` (default 10).
     ``sched_fifo_trial`` (tried only in safety mode with ``use_real_time`` true) and
     ``memlock_check`` (only with ``safety.lock_memory``) return ``(ok, message)``; tests
-    replace them.
+    replace them. ``frequencies_in_use``: ``(node, "<plugin>.rt_freq|freq")`` of the
+    frequencies the loaded plugins run at; when given, the frequency rule looks only at those
+    (every plugin declares both, and a part it does not have schedules nothing); None checks
+    every one (a params file alone).
 
     Checks, in any mode: robot limits finite with max_* >= 0, min_linear_vel <= 0,
     accelerations/decelerations > 0; system_node.rt_freq/freq and every ``<plugin>.rt_freq``/
@@ -156,7 +162,7 @@ def configuration_errors(
     """
     check = _Checker(parameters)
     limits = _robot_limits(check)
-    _frequencies(check)
+    _frequencies(check, frequencies_in_use)
 
     cmd_timeout = check.number(CONTROLLER, "cmd_timeout", ">=0", " s")
     keepalive = check.number(CONTROLLER, "cmd_vel_keepalive_period", ">=0", " s")

@@ -28,8 +28,11 @@ class RTCycleMonitor:
     time makes it RT_OK again, so isolated late cycles never add up to an error.
 
     The status is reported as ``diagnostics.rt_cycle`` (hardware_id ``system_node``): WARN for
-    LATE, ERROR for ERROR, OK when back on time; written only on changes and after the first
-    problem. :meth:`restart` (on activation) starts over: inactive time is not a late cycle.
+    LATE, OK when back on time; for ERROR, an ERROR diagnostic in safety mode (``safety_mode``,
+    where it stops EasyNav) and only a WARN outside it (seed-design: outside safety mode a late
+    RT cycle is only a WARN; the message and ``status`` still say ERROR). Written only on
+    changes and after the first problem. :meth:`restart` (on activation) starts over: inactive
+    time is not a late cycle.
 
     Thread contract: :meth:`on_cycle_start` from the RT thread only; :meth:`restart` from the
     lifecycle thread while the RT loop does not run; the read-only properties from any thread
@@ -43,7 +46,11 @@ class RTCycleMonitor:
     RT_ERROR = RT_ERROR
 
     def __init__(
-        self, rt_freq: float, max_period_factor: float = 2.0, max_late_cycles: int = 10
+        self,
+        rt_freq: float,
+        max_period_factor: float = 2.0,
+        max_late_cycles: int = 10,
+        safety_mode: bool = False,
     ) -> None:
         if not (math.isfinite(rt_freq) and rt_freq > 0.0):
             raise ValueError(f"rt_freq = {rt_freq} must be finite and > 0")
@@ -61,6 +68,7 @@ class RTCycleMonitor:
         self.max_period_factor = float(max_period_factor)
         self.max_late_cycles = max_late_cycles
         self.max_interval = self.period * self.max_period_factor
+        self.safety_mode = bool(safety_mode)
         self._previous_start: float | None = None
         self._status = RT_OK
         self._late_cycles = 0
@@ -134,8 +142,11 @@ class RTCycleMonitor:
             )
         else:
             message = "real-time cycles on time"
+        level = _LEVELS[self._status]
+        if not self.safety_mode and level == DiagnosticLevel.ERROR:
+            level = DiagnosticLevel.WARN  # only reported outside safety mode: never an ERROR
         return DiagnosticStatus(
-            level=_LEVELS[self._status],
+            level=level,
             name=self.NAME,
             message=message,
             hardware_id=self.HARDWARE_ID,

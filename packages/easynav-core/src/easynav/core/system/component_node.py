@@ -146,6 +146,8 @@ class ComponentNode(LifecycleNode):
             robot_geometry=self.system.robot_geometry,
             robot_limits=self.system.robot_limits,
             services=self.system.services,
+            rt_node=self.system.rt_node,
+            frequencies_in_use=self.system.frequencies_in_use,
         )
 
     def plugin_aliases(self) -> list[tuple[str, str]]:
@@ -187,11 +189,15 @@ class ComponentNode(LifecycleNode):
                 raise ConfigurationError(f"{node}: plugin '{name}' ({alias}): {exc}") from exc
             lp = LoadedPlugin(alias, name, plugin, self.system.diagnostic_name(node, alias))
             if plugin.HAS_RT_UPDATE and self.MONITOR_RT:
+                # The message names the parameter as the key does: node-qualified when several
+                # nodes share the alias (the seed calls every plugin "simple").
                 lp.rt_monitor = RateMonitor(
-                    f"{lp.diag_name}.rt_rate", plugin.rt_freq, node, f"{alias}.rt_freq"
+                    f"{lp.diag_name}.rt_rate", plugin.rt_freq, node, f"{lp.diag_name}.rt_freq"
                 )
             if plugin.HAS_UPDATE and self.MONITOR_NON_RT:
-                lp.monitor = RateMonitor(f"{lp.diag_name}.rate", plugin.freq, node, f"{alias}.freq")
+                lp.monitor = RateMonitor(
+                    f"{lp.diag_name}.rate", plugin.freq, node, f"{lp.diag_name}.freq"
+                )
             self.plugins.append(lp)
 
     #: Which rates are monitored for this node's plugins (REFERENCE: rt_rate for controllers and
@@ -203,7 +209,7 @@ class ComponentNode(LifecycleNode):
         """Let every plugin release its resources, then forget them."""
         for lp in self.plugins:
             try:
-                lp.plugin.on_cleanup()
+                lp.plugin.cleanup()
             except Exception as exc:
                 self.get_logger().warning(f"{lp.alias}: on_cleanup failed: {exc}")
         self.plugins = []

@@ -18,7 +18,7 @@ from rclpy.qos import (
 )
 
 from easynav.core.diagnostics import write_diagnostic
-from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
+from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER, SPEED_LIMIT
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
 from easynav.core.ros.converters import header_to_msg, twist_to_msg
@@ -184,7 +184,13 @@ class ControllerNode(ComponentNode):
         paused = bool(nav_state.get_or("navigation_paused", False))
         safety = nav_state.get("safety_status") if nav_state.has("safety_status") else None
         inhibited = bool(nav_state.get_or("motion_inhibited", False))
-        output.set_limits(self.limits_in_force())
+        # A speed zone (NavState speed_limit, a fraction) cuts the limits the output enforces,
+        # not those controllers see: the zone is the velocity output's, as the safety cut is.
+        zone = nav_state.get_or(SPEED_LIMIT, 1.0)
+        limits = self.limits_in_force()
+        if isinstance(zone, float):
+            limits = limits.scaled(zone)
+        output.set_limits(limits)
         command = output.cycle(now, controller_cmd, takeover, override, paused, safety, inhibited)
         # Proposals last one cycle.
         if takeover is not None:

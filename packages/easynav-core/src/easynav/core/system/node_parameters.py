@@ -40,10 +40,24 @@ class NodeParameters(ParameterAccess):
             try:
                 return node.get_parameter(name).value
             except ParameterUninitializedException:  # an empty list declared by type only
-                return default
+                return [] if isinstance(default, list) else default
         descriptor = ParameterDescriptor(description=description)
         override = node._parameter_overrides.get(name)  # rclpy keeps them here, by full name
         try:
+            if (
+                isinstance(default, list)
+                and override is not None
+                and override.type_ == Parameter.Type.NOT_SET
+            ):
+                # ``filters: []`` in a params file: rclpy reads an empty YAML list as NOT_SET.
+                # The user meant an empty list: declare it typed like the default, empty.
+                kind = (
+                    Parameter.Type.from_parameter_value(default)
+                    if default
+                    else Parameter.Type.STRING_ARRAY
+                )
+                node.declare_parameter(name, kind, descriptor, ignore_override=True)
+                return []
             if isinstance(default, list) and not default:
                 # An empty list has no type of its own: the override's type wins, strings else.
                 if override is not None:

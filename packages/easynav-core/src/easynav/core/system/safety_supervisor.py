@@ -117,8 +117,10 @@ class SafetySupervisor:
         return guard
 
     def before_configure(self) -> None:
-        """Declarations are allowed while EasyNav configures."""
+        """Declarations are allowed while EasyNav configures; the plugins about to load record
+        again which frequencies they use."""
         self.freeze.unfreeze()
+        self.node.system.frequencies_in_use.clear()
 
     # -- configure ---------------------------------------------------------------------------------
     def configure(self) -> None:
@@ -130,6 +132,7 @@ class SafetySupervisor:
             {n: {name: value for name, (_t, value) in params.items()} for n, params in
              parameters.items()},
             self._controller_rt_freq(),
+            frequencies_in_use=self.node.system.frequencies_in_use,
         )
         if errors:
             raise ConfigurationError("; ".join(errors))
@@ -137,6 +140,7 @@ class SafetySupervisor:
             float(node.parameters["rt_freq"]),
             float(p["safety.rt_monitor.max_period_factor"]),
             int(p["safety.rt_monitor.max_late_cycles"]),
+            safety_mode=self.mode,
         )
         self.pose_check = PoseAgeCheck(float(p["safety.max_pose_age"]))
         self._configure_heartbeat(float(p["safety.heartbeat.period"]))

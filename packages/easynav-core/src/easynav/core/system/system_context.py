@@ -27,6 +27,10 @@ class SystemContext:
     robot_limits: Callable[[], RobotLimits] = RobotLimits
     diagnostic_names: dict[tuple[str, str], str] = field(default_factory=dict)
     services: dict[str, Any] = field(default_factory=dict)
+    #: A node spun by the RT loop (system_node's RT companion), for plugins' RT-side inputs.
+    rt_node: Any = None
+    #: ``(node, "<plugin>.rt_freq|freq")`` used by the loaded plugins (filled as they load).
+    frequencies_in_use: set[tuple[str, str]] = field(default_factory=set)
 
     def diagnostic_name(self, node_name: str, alias: str) -> str:
         """The name under ``diagnostics.`` for a plugin: its alias, or ``<node>.<alias>`` when

@@ -116,6 +116,7 @@ class SystemNode(LifecycleNode):
         # A hidden companion node spun by the RT loop: what system_node receives on the RT side
         # (the safety channel's status, TF). rclpy serves a node from one executor only.
         self.rt_io_node = Node("_system_node_rt", namespace=namespace, **kwargs)
+        self.system.rt_node = self.rt_io_node  # plugins' RT-side subscriptions (odometry)
         self.tf_listener = TFListener(self.rt_io_node)
         self.safety = SafetySupervisor(self, self.rt_io_node)
         self.add_extension(self.safety)

@@ -74,6 +74,8 @@ class InflationFilter(CostmapFilter):
         self._signature: tuple | None = None
         self._base_raw: np.ndarray | None = None
         self._inscribed_warning: str | None = None
+        self._table_key: tuple | None = None
+        self._table: np.ndarray | None = None
 
     def on_initialize(self) -> None:
         self._signature = None
@@ -114,12 +116,14 @@ class InflationFilter(CostmapFilter):
         return value
 
     def settings(self, resolution: float) -> tuple[int, np.ndarray]:
-        """``(cell radius, cost table by squared cell distance)`` for ``resolution``."""
+        """``(cell radius, cost table by squared cell distance)`` for ``resolution`` (the table
+        is rebuilt only when an input changes: a large radius makes it thousands of entries)."""
         cell_radius = cell_inflation_radius(self.params.inflation_radius, resolution)
-        table = inflation_cost_table(
-            cell_radius, resolution, self.inscribed_radius(), self.params.cost_scaling_factor
-        )
-        return cell_radius, table
+        key = (cell_radius, resolution, self.inscribed_radius(), self.params.cost_scaling_factor)
+        if key != self._table_key or self._table is None:
+            self._table = inflation_cost_table(*key)
+            self._table_key = key
+        return cell_radius, self._table
 
     def update(self, nav_state: NavState, costmap: Costmap2D) -> None:
         """Inflate ``costmap`` in place. Non-RT thread."""

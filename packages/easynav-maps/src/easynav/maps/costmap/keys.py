@@ -6,6 +6,7 @@ writing the strings.
 
 from __future__ import annotations
 
+from easynav.core.nav_state_keys import SPEED_LIMIT as _SPEED_LIMIT
 from easynav.core.nav_state_keys import NavStateKey
 
 MAP_BASE = NavStateKey(
@@ -36,9 +37,5 @@ MAP_OBSTACLE_BOUNDS = NavStateKey(
     "map only there.",
 )
 
-SPEED_LIMIT = NavStateKey(
-    "speed_limit",
-    "float",
-    "the speed limit in force at the robot's position, as a fraction (0, 1] of robot_limits "
-    "(1.0 outside every speed zone) (SpeedFilter).",
-)
+# Declared in the kernel, which honours it (the velocity output cuts the limits by it).
+SPEED_LIMIT = _SPEED_LIMIT

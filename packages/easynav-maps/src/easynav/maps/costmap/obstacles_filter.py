@@ -60,11 +60,13 @@ class ObstaclesFilter(CostmapFilter):
     def __init__(self) -> None:
         super().__init__()
         self._marks: np.ndarray | None = None
+        self._marked = np.empty(0, dtype=np.int64)
         self._grid: tuple | None = None
         self._throttle = WarningThrottle(period=5.0)
 
     def on_initialize(self) -> None:
         self._marks = None
+        self._marked = np.empty(0, dtype=np.int64)
         self._grid = None
         # Compile the ray caster (or load it from numba's cache) now, not in the first cycle.
         clear_along_rays(np.zeros((2, 2)), (0, 0), np.array([1]), np.array([1]), 1.0, 2.0)
@@ -78,20 +80,27 @@ class ObstaclesFilter(CostmapFilter):
         grid = (costmap.data.shape, costmap.resolution, costmap.origin_x, costmap.origin_y)
         if self._marks is None or grid != self._grid:
             self._marks = np.full(costmap.data.shape, NOT_MARKED, dtype=np.float64)
+            self._marked = np.empty(0, dtype=np.int64)
             self._grid = grid
         return self._marks
 
     def update(self, nav_state: NavState, costmap: Costmap2D) -> None:
-        """Mark and clear ``costmap`` in place. Non-RT thread."""
+        """Mark and clear ``costmap`` in place. Non-RT thread.
+
+        The work is proportional to the points and the marked cells, not to the map: the marked
+        cells are kept as a list of flat indices beside the per-cell times.
+        """
         perceptions = nav_state.get_no_group(PointPerception)
         if not perceptions:
             self._throttle.warn(
                 self.logger, "no-perceptions", f"{self.plugin_name}: no point perceptions"
             )
         marks = self._marks_for(costmap)
+        flat_marks = marks.reshape(-1)  # a view: marks is C-contiguous
         persistence = self.params.persistence
-        if persistence == 0.0:
-            marks.fill(NOT_MARKED)
+        if persistence == 0.0:  # the original: only this cycle's points
+            flat_marks[self._marked] = NOT_MARKED
+            self._marked = np.empty(0, dtype=np.int64)
         buffer = get_tf_buffer(self.context.namespace)
         map_frame = buffer.get_tf_info().map_frame
         newest = -math.inf
@@ -99,6 +108,7 @@ class ObstaclesFilter(CostmapFilter):
             ((label, p) for label, p in perceptions.items() if p.valid),
             key=lambda item: item[1].stamp,
         )
+        added = [self._marked]
         for label, perception in ordered:
             ops = PointPerceptionsOps({label: perception}, buffer, self.logger)
             ops.downsample(costmap.resolution).fuse(map_frame)
@@ -118,21 +128,25 @@ class ObstaclesFilter(CostmapFilter):
                         self.params.raytrace_max_range / costmap.resolution,
                     )
             inside = costmap.in_bounds(ix, iy)
-            ix, iy = ix[inside], iy[inside]
-            marks[iy, ix] = np.maximum(marks[iy, ix], stamp)
+            flat = iy[inside] * costmap.width + ix[inside]
+            flat_marks[flat] = np.maximum(flat_marks[flat], stamp)
+            added.append(flat)
+        marked = np.unique(np.concatenate(added)) if len(added) > 1 else self._marked
+        times = flat_marks[marked]
         if persistence > 0.0:
             now = max(float(self.now()), newest)
-            marks[marks < now - persistence] = NOT_MARKED
-        marked = marks > NOT_MARKED
+            expired = times < now - persistence
+            flat_marks[marked[expired]] = NOT_MARKED
+            times = np.where(expired, NOT_MARKED, times)
+        self._marked = marked = marked[times > NOT_MARKED]  # cleared or expired: gone
         if newest > -math.inf:
             nav_state.set(MAP_TIME, newest)
-        rows = np.flatnonzero(marked.any(axis=1))
-        if len(rows) == 0:
+        if len(marked) == 0:
             return
-        costmap.data[marked] = LETHAL_OBSTACLE
-        cols = np.flatnonzero(marked.any(axis=0))
+        rows, cols = np.divmod(marked, costmap.width)
+        costmap.data[rows, cols] = LETHAL_OBSTACLE  # whatever the array's memory layout
         (x0, x1), (y0, y1) = costmap.cell_to_world(
-            np.array([cols[0], cols[-1]]), np.array([rows[0], rows[-1]])
+            np.array([cols.min(), cols.max()]), np.array([rows.min(), rows.max()])
         )
         self.extend_obstacle_bounds(nav_state, (float(x0), float(y0), float(x1), float(y1)))
 

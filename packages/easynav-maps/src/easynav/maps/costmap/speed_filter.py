@@ -50,9 +50,10 @@ class SpeedFilter(CostmapFilter):
     keep grey levels): the value ``v`` (0…100) of the mask cell under the robot
     (``robot_pose``) gives ``limit = base + multiplier · v``, a percent of the maximum speed
     (``type: percent``) or m/s (``type: absolute``); 0 or -1 is no zone. ``speed_limit`` is that
-    limit as a **fraction** (0, 1] of ``robot_limits`` (1.0 outside every zone), for the
-    linear and angular speeds alike: the velocity output cuts the limits in force by it. The
-    costmap itself is not changed.
+    limit as a **fraction** (0, 1] of the limits in force (1.0 outside every zone), for the
+    linear and angular speeds alike: controller_node's velocity output cuts the limits it
+    enforces by it (controllers keep seeing the limits without the zone). The costmap itself is
+    not changed.
 
     Thread contract: as :class:`CostmapFilter`. ``speed_limit`` is not written while the robot
     pose is unknown. Exceptions: configure fails naming ``mask_path_file`` when the mask is

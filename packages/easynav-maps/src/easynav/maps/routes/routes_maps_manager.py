@@ -55,6 +55,9 @@ class RoutesMapsManager(MapsManagerBase):
     )
     WRITES = (ROUTES,)
     PROVIDES_MAPS = ("routes",)
+    # Its filters (RoutesCostmapFilter) edit the costmap another maps manager writes, listed
+    # before it in map_types: alone it has nothing to steer.
+    NEEDS_MAPS = ("costmap",)
 
     def __init__(self) -> None:
         super().__init__()

@@ -24,6 +24,8 @@ class EvaluatorBase(MethodBase):
     """
 
     HARDWARE_ID = ""
+    #: Evaluators run in the non-RT cycle at ``freq`` (the manager schedules them).
+    HAS_UPDATE = True
 
     @property
     def diagnostic_name(self) -> str:

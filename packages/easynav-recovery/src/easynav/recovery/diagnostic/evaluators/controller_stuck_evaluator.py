@@ -8,6 +8,7 @@ import math
 
 from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
+from easynav.core.tf import TransformError, get_tf_buffer
 from easynav.core.types import DiagnosticLevel, Odometry, TwistStamped
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.evaluator_base import EvaluatorBase
@@ -33,6 +34,12 @@ class ControllerStuckEvaluator(EvaluatorBase):
     already raised stays until the robot moves more than the threshold — so escalation goes on
     while a held robot stays stuck, and ends as soon as it moves.
 
+    Progress is the distance actually driven: the odometry (the latest ``odom_frame →
+    robot_footprint_frame`` transform in this EasyNav's TF buffer, as the robot's driver
+    publishes it), so a localisation that drifts or jumps (``map → odom``) while the robot is
+    held cannot pass for progress. Without odometry in TF (e.g. a system without a driver's
+    ``odom`` frame) it falls back to ``robot_pose``; a change of source restarts the window.
+
     Thread contract: as :class:`EvaluatorBase`.
     """
 
@@ -44,7 +51,8 @@ class ControllerStuckEvaluator(EvaluatorBase):
             self, "progress_distance_threshold", 0.05, positive=True
         )
         self.stuck_time_threshold = read_float(self, "stuck_time_threshold", 2.0, positive=True)
-        self._reference: tuple[float, float] | None = None
+        # (source, x, y): source "odom" (odometry from TF) or "robot_pose" (the fallback).
+        self._reference: tuple[str, float, float] | None = None
         self._reference_time = 0.0
         self._level = DiagnosticLevel.OK
         self._stuck_message = ""
@@ -78,7 +86,12 @@ class ControllerStuckEvaluator(EvaluatorBase):
             return self._ok(nav_state, "not commanded to move", position, now)
         if position is None:
             return self._ok(nav_state, "no robot pose yet", position, now)
-        if self._reference is None or self._moved(position) or now < self._reference_time:
+        if (
+            self._reference is None
+            or self._reference[0] != position[0]  # odometry appeared or went: a new window
+            or self._moved(position)
+            or now < self._reference_time
+        ):
             return self._ok(nav_state, "making progress", position, now)
         stuck_for = now - self._reference_time
         if stuck_for < self.stuck_time_threshold:
@@ -109,26 +122,38 @@ class ControllerStuckEvaluator(EvaluatorBase):
                 return f"a safety reflex intervenes ({status.name})"
         return ""
 
-    def _position(self, nav_state: NavState) -> tuple[float, float] | None:
+    def _position(self, nav_state: NavState) -> tuple[str, float, float] | None:
+        """Where the robot is by its odometry (``("odom", x, y)``), else by ``robot_pose``."""
+        buffer = get_tf_buffer(self.context.namespace)
+        tf_info = buffer.get_tf_info()
+        try:
+            _, values = buffer.lookup_transform_values(
+                tf_info.odom_frame, tf_info.robot_footprint_frame
+            )
+        except TransformError:
+            values = None
+        if values is not None and math.isfinite(values[0]) and math.isfinite(values[1]):
+            return "odom", values[0], values[1]
         if not nav_state.has(keys.ROBOT_POSE):
             return None
         pose = nav_state.get(keys.ROBOT_POSE, Odometry).pose
         if not (math.isfinite(pose.x) and math.isfinite(pose.y)):
             return None
-        return pose.x, pose.y
+        return "robot_pose", pose.x, pose.y
 
-    def _moved(self, position: tuple[float, float] | None) -> bool:
-        if position is None or self._reference is None:
+    def _moved(self, position: tuple[str, float, float] | None) -> bool:
+        reference = self._reference
+        if position is None or reference is None or position[0] != reference[0]:
             return False
-        dx = position[0] - self._reference[0]
-        dy = position[1] - self._reference[1]
+        dx = position[1] - reference[1]
+        dy = position[2] - reference[2]
         return math.hypot(dx, dy) > self.progress_distance_threshold
 
     def _ok(
         self,
         nav_state: NavState,
         message: str,
-        position: tuple[float, float] | None,
+        position: tuple[str, float, float] | None,
         now: float,
     ) -> None:
         # Re-arm: a full window of non-progress is needed from here.

@@ -30,6 +30,12 @@ class SafeRetreatRecovery(MitigationBase):
     held in place does not retreat forever). Points below ``z_min_filter`` (0.0 m) or above
     ``robot_geometry.height`` are ignored. The collision reflex still checks every command.
 
+    The robot limits in force are respected, read every cycle: a robot with
+    ``robot_limits.min_linear_vel = 0`` cannot reverse, so it is never sent backwards (an
+    obstacle ahead with no way forward is FAILED, naming the limit, and the next mitigation
+    gets its turn); the speed is at most ``max_linear_vel`` forward and ``-min_linear_vel``
+    backward.
+
     Thread contract: as :class:`MitigationBase`.
     """
 
@@ -78,6 +84,10 @@ class SafeRetreatRecovery(MitigationBase):
                 f"timeout = {self.timeout:g} s"
             )
 
+        limits = self.context.robot_limits()
+        # The speed the robot may drive each way (0: it cannot, e.g. min_linear_vel = 0).
+        speeds = {1: max(limits.max_linear_vel, 0.0), -1: max(-limits.min_linear_vel, 0.0)}
+
         def clear(direction: int) -> bool:
             free = free_distance_along_x(points, direction, self.robot_radius)
             return free >= self.min_clearance
@@ -85,20 +95,37 @@ class SafeRetreatRecovery(MitigationBase):
         if self.direction == 0:
             preferred = -1 if math.cos(nearest.bearing) > 0.0 else 1
             beside = abs(math.cos(nearest.bearing)) < 0.5  # 60–120°
-            if clear(preferred):
+            if speeds[preferred] > 0.0 and clear(preferred):
                 self.direction = preferred
-            elif beside and clear(-preferred):
+            elif beside and speeds[-preferred] > 0.0 and clear(-preferred):
                 self.direction = -preferred
+            elif speeds[preferred] <= 0.0:
+                return self._fail(self._cannot_drive(preferred, limits))
             else:
                 return self._fail(
                     f"no clear way away from the obstacle (bearing {nearest.bearing:.2f} rad)"
                 )
             way = "forward" if self.direction > 0 else "backward"
             self.report(logging_levels.WARN, f"moving {way} away from the obstacle")
+        elif speeds[self.direction] <= 0.0:  # the limits changed while retreating
+            return self._fail(self._cannot_drive(self.direction, limits))
         elif not clear(self.direction):
             return self._fail("the way is blocked")
-        self.command_velocity(Twist(vx=self.direction * self.retreat_speed))
+        speed = min(self.retreat_speed, speeds[self.direction])
+        self.command_velocity(Twist(vx=self.direction * speed))
         return RecoveryStatus.RUNNING
+
+    @staticmethod
+    def _cannot_drive(direction: int, limits) -> str:
+        if direction < 0:
+            return (
+                f"cannot back away from the obstacle ahead: robot_limits.min_linear_vel = "
+                f"{limits.min_linear_vel:g} (the robot does not reverse)"
+            )
+        return (
+            f"cannot move away from the obstacle behind: robot_limits.max_linear_vel = "
+            f"{limits.max_linear_vel:g}"
+        )
 
     def _fail(self, why: str) -> RecoveryStatus:
         self.stop_robot()
