@@ -71,11 +71,14 @@ def test_astar_cost_equals_exhaustive_dijkstra_on_random_maps(solver, diagonal):
             assert path is None and math.isinf(cost), trial
             unreachable += 1
             continue
-        assert cost == pytest.approx(truth, rel=1e-6), trial
+        # The compiled search sums in float32: ~1e-6 relative with √2 steps.
+        assert cost == pytest.approx(truth, rel=1e-6 if solver is astar_costmap_reference
+                                     else 1e-5), trial
         cells = np.asarray(path)
         assert tuple(cells[0]) == start and tuple(cells[-1]) == goal
         # The path really costs what A* says, moves between neighbours and avoids blocked cells.
-        assert path_cost(costs, cells, cost_factor, diagonal) == pytest.approx(cost, rel=1e-9)
+        assert path_cost(costs, cells, cost_factor, diagonal) == pytest.approx(cost, rel=1e-5)
+        assert path_cost(costs, cells, cost_factor, diagonal) == pytest.approx(truth, rel=1e-6)
         checked += 1
     assert checked >= 20 and unreachable >= 5  # both cases were exercised
 
@@ -112,4 +115,5 @@ def test_compiled_and_reference_agree_on_a_larger_map():
     costs[20:40, 10:70] = 254
     a, ca = astar_costmap(costs, (0, 0), (79, 59))
     b, cb = astar_costmap_reference(costs, (0, 0), (79, 59))
-    assert ca == pytest.approx(cb, rel=1e-12) and len(a) > 0 and len(b) > 0
+    assert ca == pytest.approx(cb, rel=1e-5) and len(a) > 0 and len(b) > 0
+    assert path_cost(costs, a) == pytest.approx(cb, rel=1e-6)  # the path itself is optimal

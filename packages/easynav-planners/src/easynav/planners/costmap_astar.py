@@ -174,7 +174,9 @@ def astar_costmap(
 ) -> tuple[np.ndarray | None, float]:
     """:func:`astar_costmap_reference`'s answer, computed by the compiled search when numba is
     installed: the cell path as an ``(K, 2)`` int array of ``(ix, iy)`` (start first, goal
-    last) and its cost, or ``(None, inf)``.
+    last) and its cost, or ``(None, inf)``. The compiled search accumulates costs in float32
+    (for speed, as pyastar2d): with √2 diagonals its cost may differ from the float64
+    reference by ~1e-6 relative; with integer steps it is exact.
 
     The first call compiles the kernel (about a second; cached on disk afterwards). Any thread:
     the kernel holds no state.
