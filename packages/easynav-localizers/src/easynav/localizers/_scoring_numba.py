@@ -5,6 +5,9 @@ Importing this module requires numba (``pip install easynav-localizers[numba]``)
 particles × points with no intermediate arrays; cell arithmetic in float64 (the numpy version
 uses float32 to save memory traffic, so a point within ~1e-6 of a cell edge may fall on the
 other side in one of them).
+
+Compiled with ``nogil``: a long search or scoring does not hold the GIL, so the RT loop (the
+controller) keeps its rate meanwhile.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def score_kernel(poses, points_xy, values, width, height, origin_x, origin_y, resolution):
     """``(fractions, possible)`` as :func:`hit_fractions` returns them."""
     n = poses.shape[0]

@@ -12,6 +12,9 @@ bounds a grid search of a million cells (as pyastar2d, the benchmark's reference
   floats order as their bits; exact ties of ``f`` go to the lower cell index), with lazy
   deletion (stale entries are skipped when popped);
 - the grid gets a one-cell blocked border so that neighbours need no bounds checks.
+
+Compiled with ``nogil``: a long search or scoring does not hold the GIL, so the RT loop (the
+controller) keeps its rate meanwhile.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from numba import njit
 _BLOCKED = 253
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _push(heap, size, key):
     # Sift up with a hole: parents move down until the key's place is found.
     pos = size
@@ -35,7 +38,7 @@ def _push(heap, size, key):
     heap[pos] = key
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _pop(heap, size):
     # Remove the root of a heap of ``size`` keys: the last key sifts down from the root.
     size -= 1
@@ -59,7 +62,7 @@ def _pop(heap, size):
     heap[pos] = key
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _octile(dx, dy, diagonal_cost):
     dx = abs(dx)
     dy = abs(dy)
@@ -68,7 +71,7 @@ def _octile(dx, dy, diagonal_cost):
     return dy + (diagonal_cost - 1.0) * dx
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def astar_kernel(costs, sx, sy, gx, gy, cost_factor, heuristic_scale, diagonal_cost):
     """``(cells (K, 2) int64 of (ix, iy), cost)``; an empty array and inf when unreachable.
     ``costs`` is a C-contiguous uint8 grid ``[iy, ix]``; bounds are checked by the caller;
