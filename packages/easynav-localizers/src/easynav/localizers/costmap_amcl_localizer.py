@@ -48,8 +48,9 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
       lethal cell from an OpenCV distance transform, the weight is multiplied by ``1 + Σ pz³``,
       the cloud is resampled when its effective size falls below half). Both score every
       particle at once (:func:`hit_fractions`, vectorised over particles × points).
-    - KLD-adaptive particle count (``kld_sampling``): at each resample the cloud is resized to
-      Fox's bound for ``pf_err``/``pf_z`` within ``[min_particles, max_particles]``.
+    - KLD-adaptive particle count (``kld_sampling``): at each resample (each reseed in the
+      hit-count model, which does not resample otherwise) the cloud is resized to Fox's bound
+      for ``pf_err``/``pf_z`` within ``[min_particles, max_particles]``.
     - Global localisation: particles uniform over the free cells of ``map.base``
       (``max_particles`` of them with KLD, else ``num_particles``), on request: the service
       ``reinitialize_global_localization`` (std_srvs/Empty, as Nav2's), the parameter
@@ -351,6 +352,9 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._generation += 1
 
     def _reseed(self, base: Costmap2D) -> None:
+        # hit_count never resamples between reseeds: KLD resizes the cloud here. (The
+        # likelihood-field model resizes at its resamples only: resizing at every reseed
+        # shrank a global cloud onto wrong modes before the scans had told them apart.)
         if self.params.sensor_model == HIT_COUNT and self.params.kld_sampling:
             self._resample(base)
         else:
