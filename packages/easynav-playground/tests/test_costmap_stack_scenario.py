@@ -13,9 +13,11 @@ import os
 from pathlib import Path
 
 import pytest
+import yaml
 
 from easynav.playground.demo import run_demo
 from easynav.playground.sim import GroundTruthRecorder
+from easynav.playground.world_description import WorldDescription
 
 pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(1200)]
 
@@ -38,7 +40,12 @@ def test_costmap_stack_drives_the_real_map_tour(world, tmp_path):
     report = out.getvalue()
     assert code == 0, report
     # The demo pointed the costmap manager at the world's map and the robot radius at its robot.
-    assert "costmap loads the world's map" in report and "robot_geometry.radius" in report
+    derived = yaml.safe_load((tmp_path / "run" / "params.yaml").read_text())
+    maps = derived["maps_manager_node"]["ros__parameters"]["costmap"]
+    assert maps["package"] == "" and maps["map_path_file"].endswith(f"maps/{world}.yaml")
+    radius = WorldDescription.resolve(world).robot.radius
+    system = derived["system_node"]["ros__parameters"]
+    assert system["robot_geometry"]["radius"] == radius
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["reached"] == summary["waypoints"] >= 6, report
     assert summary["collisions"] == 0, report
