@@ -37,7 +37,6 @@ LIDAR_KEYS = (
 )
 #: The playground's robot when a world declares none (its parameter defaults).
 DEFAULT_RADIUS = 0.2
-DEFAULT_HEIGHT = 0.5
 
 
 @dataclass(frozen=True)
@@ -65,7 +64,7 @@ class RobotDescription:
     limits: dict[str, float] = field(default_factory=dict)
     laser: dict[str, float] = field(default_factory=dict)
     declared: bool = False
-    height: float = DEFAULT_HEIGHT
+    height: float | None = None  # None: not declared (the playground's robot_height default)
     lidar: dict[str, float] | None = None
 
     @classmethod
@@ -98,9 +97,11 @@ class RobotDescription:
             if not float(laser["beams"]).is_integer():
                 raise ValueError(f"{source}: robot.laser.beams must be an integer")
             laser["beams"] = int(laser["beams"])
-        height = _number(data.get("height", DEFAULT_HEIGHT), f"{source}: robot.height")
-        if height <= 0.0:
-            raise ValueError(f"{source}: robot.height must be > 0, got {height}")
+        height = None
+        if "height" in data:
+            height = _number(data["height"], f"{source}: robot.height")
+            if height <= 0.0:
+                raise ValueError(f"{source}: robot.height must be > 0, got {height}")
         lidar = None
         if "lidar" in data:
             lidar = _section(data.get("lidar") or {}, LIDAR_KEYS, "lidar", source)
@@ -116,7 +117,9 @@ class RobotDescription:
         ``laser.*``); empty for an undeclared robot."""
         if not self.declared:
             return {}
-        values: dict[str, object] = {"robot_radius": self.radius, "robot_height": self.height}
+        values: dict[str, object] = {"robot_radius": self.radius}
+        if self.height is not None:
+            values["robot_height"] = self.height
         values.update({f"base.{k}": v for k, v in self.limits.items()})
         values.update({f"laser.{k}": v for k, v in self.laser.items()})
         if self.lidar is not None:

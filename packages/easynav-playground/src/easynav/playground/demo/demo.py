@@ -134,7 +134,7 @@ def run_demo(
             derived,
             map_yaml=map_yaml.resolve(),
             robot_radius=robot.radius if robot.declared else None,
-            robot_height=robot.height if robot.declared else None,
+            robot_height=robot.height,
         )
         costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
         easynav = _easynav_command()

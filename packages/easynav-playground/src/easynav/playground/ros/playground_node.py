@@ -97,8 +97,9 @@ class PlaygroundNode(Node):
     Publishes ``/clock`` (every step), ``scan`` (``laser.rate``), ``points`` (the 3D lidar's
     PointCloud2 in ``lidar_frame``, ``lidar.rate``, with ``lidar.enabled``), ``odom`` and the
     ``odom -> base_footprint`` transform on ``tf`` (``odom_rate``), ``ground_truth`` (true pose
-    in the map frame, same rate), the static ``base_footprint -> base_link -> base_laser`` transforms on
-    ``tf_static``, ``collisions`` (latched JSON: count and the last collision) and the world on
+    in the map frame, same rate), the static ``base_footprint -> base_link -> base_laser`` (and
+    ``-> base_lidar``) transforms on ``tf_static``, ``collisions`` (latched JSON: count and the
+    last collision) and the world on
     ``playground/world`` (latched OccupancyGrid). Subscribes ``cmd_vel`` (Twist),
     ``cmd_vel_stamped`` (TwistStamped) and ``playground/hold`` (std_msgs/Bool, transient local:
     hold the robot in place, wheels blocked; the ``hold`` parameter is the initial state). It
