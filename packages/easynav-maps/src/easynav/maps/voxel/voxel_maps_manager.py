@@ -41,6 +41,9 @@ COMMON_PARAMETERS = (
           ge=0.0),
     Param("filters", [], "costmap filter aliases run on the 2D projection, in order",
           type="str[]"),
+    Param("perception_group", "",
+          "NavState group of the point perceptions inserted (empty: the ungrouped ones), e.g. "
+          "a 3D lidar grouped away from the 2D localizer"),
     Param("save_map_path", "", "where savemap writes (empty: the loaded file, else the temp dir)"),
     Param("publish_period", 1.0, "least time between two publications of the voxel cloud", "s",
           ge=0.0),
@@ -50,8 +53,8 @@ COMMON_PARAMETERS = (
 class VoxelMapsManager(CostmapMapsManager):
     """A 3D voxel map fed by the point perceptions, and its 2D costmap for the 2D stack.
 
-    Every cycle each new valid ungrouped :class:`PointPerception` (a newer stamp than the last
-    inserted from that sensor) is transformed into the map frame, its points below ``min_z``
+    Every cycle each new valid :class:`PointPerception` (ungrouped, or of the NavState group
+    ``perception_group``; a newer stamp than the last inserted from that sensor) is transformed into the map frame, its points below ``min_z``
     (the floor) dropped, and inserted with ray casting from the sensor origin (the sensor
     frame's origin in the map frame): voxels crossed become freer, end voxels more occupied.
     The 2D projection marks lethal (254) every cell under an occupied voxel that reaches into
@@ -236,7 +239,12 @@ class VoxelMapsManager(CostmapMapsManager):
         CostmapFilter.extend_obstacle_bounds(nav_state, bounds)
 
     def _insert_perceptions(self, nav_state: NavState) -> float:
-        perceptions = nav_state.get_no_group(PointPerception)
+        group = self.params.perception_group
+        if group:
+            members = nav_state.get_group(group) if group in nav_state.groups() else {}
+            perceptions = {k: v for k, v in members.items() if isinstance(v, PointPerception)}
+        else:
+            perceptions = nav_state.get_no_group(PointPerception)
         if not perceptions:
             self._throttle.warn(
                 self.logger, "no-perceptions", f"{self.plugin_name}: no point perceptions"
