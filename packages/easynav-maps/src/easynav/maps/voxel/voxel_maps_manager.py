@@ -54,9 +54,9 @@ class VoxelMapsManager(CostmapMapsManager):
     """A 3D voxel map fed by the point perceptions, and its 2D costmap for the 2D stack.
 
     Every cycle each new valid :class:`PointPerception` (ungrouped, or of the NavState group
-    ``perception_group``; a newer stamp than the last inserted from that sensor) is transformed into the map frame, its points below ``min_z``
-    (the floor) dropped, and inserted with ray casting from the sensor origin (the sensor
-    frame's origin in the map frame): voxels crossed become freer, end voxels more occupied.
+    ``perception_group``; a newer stamp than the last inserted from that sensor) is transformed
+    into the map frame, its points below ``min_z`` (the floor) dropped, and inserted with ray
+    casting from the sensor origin (the sensor frame's origin in the map frame): voxels crossed become freer, end voxels more occupied.
     The 2D projection marks lethal (254) every cell under an occupied voxel that reaches into
     ``[min_z, robot_geometry.height]`` (what the robot would hit; a table top above it is not).
 
