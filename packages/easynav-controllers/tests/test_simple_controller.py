@@ -106,21 +106,33 @@ def test_closed_loop_reaches_the_path_end_and_stops():
     assert all(b > a for a, b in zip(stamps[:-1], stamps[1:], strict=True))  # every one new
 
 
-def test_deprecated_limits_still_cap_the_command():
-    controller = make_controller({"max_linear_speed": 0.1, "max_angular_speed": 0.2})
-    limits = controller.limits()
-    assert limits.max_linear_vel == 0.1 and limits.max_angular_vel == 0.2
-    assert limits.max_linear_acc == RobotLimits().max_linear_acc  # not set: robot_limits
-    assert make_controller().limits() == RobotLimits()
+def test_only_the_limits_in_force_are_used_no_stale_deprecated_cap():
+    # The deprecated per-controller limits are declared (a params file with them still loads);
+    # controller_node turns them into robot_limits. The controller itself never takes a
+    # minimum with them: a runtime change or a slow-down of robot_limits is what counts.
+    in_force = RobotLimits(max_linear_vel=0.4)
+    controller = make_controller({"max_linear_speed": 0.1}, limits=in_force)
+    assert controller.params.max_linear_speed == 0.1
+    assert controller.limits() == in_force
+
+
+def test_a_runtime_change_is_validated_and_rebuilds_the_follower():
+    controller = make_controller({"look_ahead_dist": 0.3})
+    with pytest.raises(ValueError, match=r"simple.look_ahead_dist = -1.0: must be > 0"):
+        controller.validate_parameter("look_ahead_dist", -1.0)
+    controller.apply_parameter("look_ahead_dist", controller.validate_parameter(
+        "look_ahead_dist", 0.7))
+    assert controller.params.look_ahead_dist == 0.7
+    assert controller.follower.look_ahead_dist == 0.7
 
 
 @pytest.mark.parametrize(
     ("params", "message"),
     [
-        ({"k_rot": "fast"}, "simple.k_rot = 'fast' is not a number"),
-        ({"look_ahead_dist": -0.5}, "look_ahead_dist = -0.5"),
-        ({"max_linear_speed": -1.0}, "simple.max_linear_speed = -1.0 must be >= 0"),
-        ({"tolerance_dist": float("nan")}, "simple.tolerance_dist = nan is not finite"),
+        ({"k_rot": "fast"}, "simple.k_rot = 'fast': must be a number"),
+        ({"look_ahead_dist": -0.5}, "simple.look_ahead_dist = -0.5: must be > 0"),
+        ({"max_linear_speed": -1.0}, "simple.max_linear_speed = -1.0: must be >= 0"),
+        ({"tolerance_dist": float("nan")}, "simple.tolerance_dist = nan: must be a number"),
     ],
 )
 def test_bad_parameters_fail_configuration(params, message):

@@ -103,5 +103,6 @@ def test_controller_faults_are_the_documented_ones(make_plugin):
     with pytest.raises(PluginConfigurationError) as info:
         make_plugin(FaultyController, fault="empty_path")
     assert str(info.value).endswith(
-        "valid faults are none, throw, hang, stop_proposing, freeze, max_velocity, nan"
+        "must be one of 'none', 'throw', 'hang', 'stop_proposing', 'freeze', 'max_velocity', "
+        "'nan'"
     )

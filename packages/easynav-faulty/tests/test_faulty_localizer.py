@@ -85,7 +85,7 @@ def test_jump_moves_the_pose_jump_distance_ahead(make_plugin, clock):
 
 @pytest.mark.parametrize("name", ["x", "y", "yaw", "jump_distance"])
 def test_pose_parameters_must_be_finite(make_plugin, name):
-    with pytest.raises(PluginConfigurationError, match=f"faulty.{name} = nan must be finite"):
+    with pytest.raises(PluginConfigurationError, match=f"faulty.{name} = nan: must be a number"):
         make_plugin(FaultyLocalizer, **{name: float("nan")})
 
 
@@ -93,5 +93,8 @@ def test_localizer_faults_are_the_documented_ones(make_plugin):
     with pytest.raises(PluginConfigurationError) as info:
         make_plugin(FaultyLocalizer, fault="stop_proposing")
     assert str(info.value).endswith(
-        "valid faults are none, throw, hang, freeze, stop_publishing, nan, jump"
+        "must be one of "
+        + ", ".join(
+            repr(f) for f in ('none', 'throw', 'hang', 'freeze', 'stop_publishing', 'nan', 'jump')
+        )
     )

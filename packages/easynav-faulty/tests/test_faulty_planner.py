@@ -131,4 +131,7 @@ def test_nan_without_a_plan_is_a_single_nan_pose(make_plugin, clock):
 def test_planner_faults_are_the_documented_ones(make_plugin):
     with pytest.raises(PluginConfigurationError) as info:
         make_plugin(FaultyPlanner, fault="jump")
-    assert str(info.value).endswith("valid faults are none, throw, hang, empty_path, freeze, nan")
+    assert str(info.value).endswith("must be one of "
+        + ", ".join(
+            repr(f) for f in ('none', 'throw', 'hang', 'empty_path', 'freeze', 'nan')
+        ))

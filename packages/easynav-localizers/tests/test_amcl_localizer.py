@@ -189,10 +189,11 @@ def test_without_map_or_perceptions_it_predicts_only():
 @pytest.mark.parametrize(
     ("params", "message"),
     [
-        ({"num_particles": 0}, "simple.num_particles = 0.0 must be an integer >= 1"),
-        ({"reseed_freq": 0.0}, "simple.reseed_freq = 0.0 must be > 0"),
-        ({"noise_rotation": -0.1}, "simple.noise_rotation = -0.1 must be >= 0"),
-        ({"initial_pose.x": "here"}, "simple.initial_pose.x = 'here' is not a number"),
+        ({"num_particles": 0}, "simple.num_particles = 0: must be >= 1"),
+        ({"num_particles": 2.5}, "simple.num_particles = 2.5: must be an integer"),
+        ({"reseed_freq": 0.0}, "simple.reseed_freq = 0.0: must be > 0"),
+        ({"noise_rotation": -0.1}, "simple.noise_rotation = -0.1: must be >= 0"),
+        ({"initial_pose.x": "here"}, "simple.initial_pose.x = 'here': must be a number"),
     ],
 )
 def test_bad_parameters_fail_configuration(params, message):

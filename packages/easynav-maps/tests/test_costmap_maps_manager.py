@@ -220,11 +220,18 @@ def test_inscribed_radius_parameter_is_a_deprecated_fallback(tmp_path, caplog):
     assert inflation.inscribed_radius() == 0.25
     assert any("deprecated" in r.message for r in caplog.records)
     configured = make_manager(
-        dict(base, **{"inflation.inscribed_radius": 0.25}), geometry=RobotGeometry(0.4, 0.15)
+        dict(base, **{"inflation.inscribed_radius": 0.25}),
+        geometry=RobotGeometry(0.4, 0.15, user_set=frozenset({"radius", "inscribed_radius"})),
     )
     assert configured.filters[0][1].inscribed_radius() == 0.15
     plain = make_manager(base, geometry=RobotGeometry(0.4, 0.15))
     assert plain.filters[0][1].inscribed_radius() == 0.15
+    # robot_geometry set to its default value still takes precedence (seed-design).
+    at_default = make_manager(
+        dict(base, **{"inflation.inscribed_radius": 0.25}),
+        geometry=RobotGeometry(user_set=frozenset({"inscribed_radius"})),
+    )
+    assert at_default.filters[0][1].inscribed_radius() == 0.3
 
 
 def test_runtime_change_of_a_filter_parameter_reaches_it(tmp_path):

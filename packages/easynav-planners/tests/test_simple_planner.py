@@ -129,18 +129,34 @@ def test_robot_geometry_radius_sets_the_clearance():
     assert "unreachable" in diagnostic(nav_state).message
 
 
-def test_deprecated_robot_radius_applies_while_geometry_is_default():
+def test_deprecated_robot_radius_applies_where_robot_geometry_does_not_set_the_radius():
     planner = make_planner({"robot_radius": 0.7})
     assert planner.planner.robot_radius == 0.7
-    configured = make_planner({"robot_radius": 0.7}, RobotGeometry(radius=0.25))
+    configured = make_planner(
+        {"robot_radius": 0.7}, RobotGeometry(radius=0.25, user_set=frozenset({"radius"}))
+    )
     assert configured.planner.robot_radius == 0.25
     assert make_planner().planner.robot_radius == 0.3
+
+
+def test_robot_geometry_set_to_its_default_value_still_takes_precedence():
+    # seed-design: "robot_geometry takes precedence when both are set", whatever the value.
+    geometry = RobotGeometry(radius=0.3, user_set=frozenset({"radius"}))
+    assert make_planner({"robot_radius": 0.7}, geometry).planner.robot_radius == 0.3
+
+
+def test_a_runtime_change_of_the_clearance_is_validated_and_used():
+    planner = make_planner()
+    with pytest.raises(ValueError, match="simple.clearance_distance = -1.0: must be >= 0"):
+        planner.validate_parameter("clearance_distance", -1.0)
+    planner.apply_parameter("clearance_distance", 0.4)
+    assert planner.planner.clearance_distance == 0.4
 
 
 def test_bad_parameters_fail_configuration_naming_them():
     with pytest.raises(PluginConfigurationError, match="simple.clearance_distance = -0.1"):
         make_planner({"clearance_distance": -0.1})
-    with pytest.raises(PluginConfigurationError, match="simple.robot_radius = 'big'"):
+    with pytest.raises(PluginConfigurationError, match="simple.robot_radius = 'big': must be"):
         make_planner({"robot_radius": "big"})
 
 

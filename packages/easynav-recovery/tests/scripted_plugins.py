@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from collections import defaultdict
 
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, Twist
 from easynav.recovery.diagnostic import EvaluatorBase, MitigationBase, RecoveryStatus
-from easynav.recovery.parameters import read_str_list
 
 #: Calls of every scripted mitigation: (alias, "start" | "cycle" | "stop").
 EVENTS: list[tuple[str, str]] = []
@@ -34,9 +34,14 @@ class ScriptedMitigation(MitigationBase):
     """Handles the hardware ids of ``<alias>.handles`` (ERROR only, WARN too with
     ``<alias>.levels: [warn]``); returns what :data:`RESULTS` says."""
 
+    PARAMETERS = (
+        Param("handles", [], "hardware ids handled", type="str[]"),
+        Param("levels", ["error"], "levels handled"),
+    )
+
     def on_initialize(self) -> None:
-        self.handles = read_str_list(self, "handles", [])
-        self.levels = read_str_list(self, "levels", ["error"])
+        self.handles = self.params.handles
+        self.levels = self.params.levels
 
     def can_handle(self, status) -> bool:
         if (_alias(self), "can_handle") in BROKEN:

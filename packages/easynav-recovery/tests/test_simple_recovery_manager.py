@@ -112,7 +112,9 @@ def test_deprecated_robot_radius_applies_with_a_warning_when_geometry_is_default
 
 
 def test_deprecated_parameters_are_ignored_when_robot_geometry_is_set(caplog):
-    geometry = RobotGeometry(radius=0.25, inscribed_radius=0.25, height=1.2)
+    geometry = RobotGeometry(
+        radius=0.25, inscribed_radius=0.25, height=1.2, user_set=frozenset({"radius", "height"})
+    )
     with caplog.at_level(logging.WARNING, logger="easynav"):
         sim = simple({"robot_radius": 0.5, "max_obstacle_z": 2.0}, geometry=geometry)
     assert sim.manager.robot_radius == 0.25
@@ -378,3 +380,11 @@ def test_context_without_ros_is_enough():
     context.services["recovery_actions"] = None
     manager.initialize(context, "recovery_manager")
     assert manager.stop_distance == 0.3 and manager.max_backup_attempts == 3
+
+
+def test_robot_geometry_set_to_its_default_values_still_takes_precedence():
+    # seed-design: robot_geometry takes precedence when both are set, whatever the value.
+    geometry = RobotGeometry(user_set=frozenset({"radius", "height"}))
+    sim = simple({"robot_radius": 0.5, "max_obstacle_z": 2.0}, geometry=geometry)
+    assert sim.manager.robot_radius == 0.3
+    assert sim.manager.max_obstacle_z == 0.5

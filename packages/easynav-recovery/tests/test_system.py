@@ -122,3 +122,26 @@ def test_the_params_examples_configure(params_file, runtime_factory, example, pl
     rt = runtime_factory(params_file(document))
     assert rt.start(), rt.error
     assert rt.system_node.loaded_plugins()["recovery_node"] == [("recovery_manager", plugin)]
+
+
+def test_a_runtime_change_of_a_sub_plugin_parameter_goes_through_its_declaration(
+    params_file, runtime_factory
+):
+    from rclpy.parameter import Parameter
+
+    rt = runtime_factory(params_file(system_params(
+        **{"recovery_node.recovery_manager": DIAGNOSTIC}
+    )))
+    assert rt.start(), rt.error
+    node = rt.system_node.recovery_node
+    name = "recovery_manager.controller_stuck.stuck_time_threshold"
+    result = node.set_parameters([Parameter(name, value=-1.0)])[0]
+    assert not result.successful
+    assert result.reason == f"{name} = -1.0: must be > 0"
+    assert node.set_parameters([Parameter(name, value=4.0)])[0].successful
+    manager = node.plugins[0].plugin
+    stuck = dict(manager.evaluators)["controller_stuck"]
+    assert stuck.params.stuck_time_threshold == 4.0 and stuck.stuck_time_threshold == 4.0
+    # A mitigation's priority is read at configure only.
+    result = node.set_parameters([Parameter("recovery_manager.advance.priority", value=1)])[0]
+    assert not result.successful and "cannot change at runtime" in result.reason

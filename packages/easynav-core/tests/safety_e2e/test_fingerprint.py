@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import re
 import subprocess
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -113,7 +114,10 @@ def test_changing_a_default_changes_the_hash(start_easynav, monkeypatch):
 
     before = configuration_hash(start_easynav, system())
     # A new version of EasyNav with another default, the params file untouched.
-    monkeypatch.setitem(system_node.SYSTEM_DEFAULTS, "update_frequency", 25.0)
+    monkeypatch.setattr(system_node, "SYSTEM_PARAMETERS", tuple(
+        replace(p, default=25.0) if p.name == "update_frequency" else p
+        for p in system_node.SYSTEM_PARAMETERS
+    ))
     after = configuration_hash(start_easynav, system())
     assert after != before
     assert "system_node/update_frequency (double) = 25.0" in saved_file(after).read_text()

@@ -74,7 +74,8 @@ def test_defaults():
          "handles sensor_msgs/msg/LaserScan"),
         ({"sensors": ["a", "a"], "a.topic": "/x", "a.type": "sensor_msgs/msg/Imu"},
          "sensors_node.sensors", "more than once"),
-        ({"sensors": "laser1"}, "sensors_node.sensors", "list of non-empty strings"),
+        ({"sensors": "laser1"}, "sensors_node.sensors", r"must be a list \(str\[\]\)"),
+        ({"sensors": ["a", ""]}, "sensors_node.sensors", "list of non-empty strings"),
     ],
 )  # fmt: skip
 def test_configuration_errors_name_the_parameter(params, parameter, text):

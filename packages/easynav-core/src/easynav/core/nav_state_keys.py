@@ -83,6 +83,36 @@ RECONFIGURED_PARAMETERS = NavStateKey(
     "``node/parameter`` changed through ``request_reconfigure``.",
 )
 
+GOAL_TOLERANCE_POSITION = NavStateKey(
+    "goal_tolerance.position", "float", "the goal manager's position tolerance (m)."
+)
+
+GOAL_TOLERANCE_YAW = NavStateKey(
+    "goal_tolerance.yaw", "float", "the goal manager's yaw tolerance (rad)."
+)
+
+GOAL_TOLERANCE_HEIGHT = NavStateKey(
+    "goal_tolerance.height", "float", "the goal manager's height tolerance (m)."
+)
+
+MAP_BASE = NavStateKey(
+    "map.base", "map", "the static map (the maps manager's representation: SimpleMap, Costmap2D)."
+)
+
+MAP = NavStateKey("map", "map", "the map with live obstacles (SimpleMap, Costmap2D).")
+
+MAP_TIME = NavStateKey("map_time", "float", "node-clock time of the last map update (s).")
+
+CONTROL_OWNER = NavStateKey(
+    "control_owner",
+    "str",
+    '"controller", or "recovery:<alias>" while a recovery mitigation drives the robot.',
+)
+
+DIAGNOSTICS_PATH = NavStateKey(
+    "diagnostics.path", "DiagnosticStatus", "the planner's diagnostic: OK, or WARN saying why."
+)
+
 SPEED_LIMIT = NavStateKey(
     "speed_limit",
     "float",

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
-from typing import Any
 
-from easynav.core.plugins import MethodBase, PluginConfigurationError
+from easynav.core.plugins import MethodBase, Param
 from easynav.faulty.injected_fault_error import InjectedFaultError
 
 #: The fault name that means "never inject anything" (the default).
@@ -19,7 +17,8 @@ class FaultInjector:
     the plugin's updates: the first ``fault_after`` updates work normally; from the next one on,
     every update has the fault (a fault is a lasting state, not a single event).
 
-    Parameters (declared through :meth:`MethodBase.get_parameter`):
+    Parameters (:meth:`parameters` gives the declarations each Faulty plugin lists in its
+    ``PARAMETERS``; the plugin base reads and validates them):
 
     - ``fault`` (str, ``"none"``): one of the plugin's faults, or ``"none"``;
     - ``fault_after`` (int >= 0, 10): normal updates before the fault;
@@ -33,9 +32,8 @@ class FaultInjector:
     Thread contract: :meth:`read_parameters` in the configuring thread; :meth:`update`,
     :meth:`hang` and :meth:`throw` in the thread that runs the counted update (RT or non-RT);
     the attributes may be read from any thread (plain attribute reads).
-    Exceptions: :meth:`read_parameters` raises :class:`PluginConfigurationError` naming the
-    parameter (an unknown fault lists the valid ones); :meth:`throw` raises
-    :class:`InjectedFaultError`.
+    Exceptions: :meth:`throw` raises :class:`InjectedFaultError` (bad parameter values fail the
+    plugin's configure, see :meth:`parameters`).
     """
 
     def __init__(self, plugin: MethodBase, faults: Sequence[str]) -> None:
@@ -57,41 +55,25 @@ class FaultInjector:
         """True once the fault is being injected."""
         return self.started_at is not None
 
+    @staticmethod
+    def parameters(faults: Sequence[str]) -> tuple[Param, ...]:
+        """The declarations of ``fault`` (choices: ``none`` and ``faults``), ``fault_after`` and
+        ``hang_time``, for a Faulty plugin's ``PARAMETERS``."""
+        valid = (NO_FAULT, *faults)
+        return (
+            Param("fault", NO_FAULT, "fault to inject", choices=valid, dynamic=False),
+            Param("fault_after", 10, "normal updates before the fault is injected", ge=0,
+                  dynamic=False),
+            Param("hang_time", 1.0, "how long each update blocks with the hang fault", "s",
+                  ge=0.0),
+        )
+
     def read_parameters(self) -> None:
-        """Declare, read and check the three parameters; restart the update count."""
-        name = self.plugin.plugin_name
-        kind = type(self.plugin).__name__
-        fault = self.plugin.get_parameter(
-            "fault", NO_FAULT, f"fault to inject: {', '.join(self.valid_faults)}"
-        )
-        if not isinstance(fault, str) or fault not in self.valid_faults:
-            raise PluginConfigurationError(
-                f"{name}.fault = {fault!r} is not a fault of {kind}: valid faults are "
-                f"{', '.join(self.valid_faults)}"
-            )
-        raw_after = self.plugin.get_parameter(
-            "fault_after", 10, "normal updates before the fault is injected"
-        )
-        fault_after = _whole_number(raw_after)
-        if fault_after is None or fault_after < 0:
-            raise PluginConfigurationError(
-                f"{name}.fault_after = {raw_after!r} must be an integer >= 0 (normal updates "
-                f"before the fault)"
-            )
-        hang_time = self.plugin.get_parameter("hang_time", 1.0, "s each update blocks (hang)")
-        try:
-            hang_time = float(hang_time)
-        except (TypeError, ValueError):
-            raise PluginConfigurationError(
-                f"{name}.hang_time = {hang_time!r} is not a number"
-            ) from None
-        if not (math.isfinite(hang_time) and hang_time >= 0.0):
-            raise PluginConfigurationError(
-                f"{name}.hang_time = {hang_time} must be finite and >= 0"
-            )
-        self.fault = fault
-        self.fault_after = fault_after
-        self.hang_time = hang_time
+        """Take the three parameters from the plugin's validated values; restart the count."""
+        params = self.plugin.params
+        self.fault = params.fault
+        self.fault_after = params.fault_after
+        self.hang_time = params.hang_time
         self.updates = 0
         self.started_at = None
 
@@ -115,7 +97,7 @@ class FaultInjector:
         which holds its cycle without using the CPU (the Dummy plugins' ``cycle_time_*`` cover
         CPU-bound slowness).
         """
-        time.sleep(self.hang_time)
+        time.sleep(self.plugin.params.hang_time)
 
     def throw(self, method: str) -> None:
         """Raise :class:`InjectedFaultError` for ``method`` (always raises)."""
@@ -123,14 +105,3 @@ class FaultInjector:
             f"{self.plugin.plugin_name}: injected fault 'throw' in {method} (update "
             f"{self.updates}, after {self.fault_after} normal updates)"
         )
-
-
-def _whole_number(value: Any) -> int | None:
-    """``value`` as an int when it is a whole number (int, or a float like 10.0); else None."""
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, int):
-        return value
-    if isinstance(value, float) and math.isfinite(value) and value.is_integer():
-        return int(value)
-    return None

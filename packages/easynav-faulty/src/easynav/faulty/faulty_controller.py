@@ -5,11 +5,11 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import ControllerMethodBase
+from easynav.core.nav_state_keys import CMD_VEL
+from easynav.core.plugins import ControllerMethodBase, Param
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Twist, TwistStamped
 from easynav.faulty.fault_injector import FaultInjector
-from easynav.faulty.parameters import finite_parameter
 
 #: Velocity of the ``max_velocity`` fault (m/s and rad/s): far beyond any robot's limits.
 ABSURD_VELOCITY = 1000.0
@@ -34,8 +34,7 @@ class FaultyController(ControllerMethodBase):
     ``nan``                   writes NaN ``vx`` and ``wz``, stamped now
     ========================= ====================================================================
 
-    Parameters (``<alias>.``): ``linear_vel`` (m/s, 0.1), ``angular_vel`` (rad/s, 0.0),
-    ``fault`` ("none"), ``fault_after`` (10), ``hang_time`` (s, 1.0).
+    Parameters: :attr:`PARAMETERS`.
 
     Thread contract: ``initialize`` in the configuring thread; ``update_rt`` in the RT thread.
     Exceptions: :class:`PluginConfigurationError` naming the parameter; ``update_rt`` raises
@@ -43,6 +42,12 @@ class FaultyController(ControllerMethodBase):
     """
 
     FAULTS = ("throw", "hang", "stop_proposing", "freeze", "max_velocity", "nan")
+    PARAMETERS = (
+        Param("linear_vel", 0.1, "forward velocity commanded", "m/s"),
+        Param("angular_vel", 0.0, "turning velocity commanded", "rad/s"),
+        *FaultInjector.parameters(FAULTS),
+    )
+    WRITES = (CMD_VEL,)
 
     def __init__(self) -> None:
         super().__init__()
@@ -52,10 +57,15 @@ class FaultyController(ControllerMethodBase):
         self.last_command: TwistStamped | None = None
 
     def on_initialize(self) -> None:
-        self.linear_vel = finite_parameter(self, "linear_vel", 0.1, "m/s, forward velocity")
-        self.angular_vel = finite_parameter(self, "angular_vel", 0.0, "rad/s, turning velocity")
+        self.linear_vel = self.params.linear_vel
+        self.angular_vel = self.params.angular_vel
         self.injector.read_parameters()
         self.last_command = None
+
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """The velocities apply from the next update."""
+        self.linear_vel = self.params.linear_vel
+        self.angular_vel = self.params.angular_vel
 
     def update_rt(self, nav_state: NavState) -> None:
         fault = self.injector.update()
@@ -69,7 +79,7 @@ class FaultyController(ControllerMethodBase):
             # Frozen at the last normal command (or at the first one, with fault_after 0).
             if self.last_command is None:
                 self.last_command = self._stamped(Twist(vx=self.linear_vel, wz=self.angular_vel))
-            nav_state.set("cmd_vel", self.last_command)
+            nav_state.set(CMD_VEL, self.last_command)
             return
         if fault == "max_velocity":
             twist = Twist(
@@ -83,7 +93,7 @@ class FaultyController(ControllerMethodBase):
         command = self._stamped(twist)
         if fault is None or fault == "hang":
             self.last_command = command
-        nav_state.set("cmd_vel", command)
+        nav_state.set(CMD_VEL, command)
 
     def _stamped(self, twist: Twist) -> TwistStamped:
         frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame

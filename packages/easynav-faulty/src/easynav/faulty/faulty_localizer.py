@@ -5,11 +5,11 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import LocalizerMethodBase
+from easynav.core.nav_state_keys import ROBOT_POSE
+from easynav.core.plugins import LocalizerMethodBase, Param
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Pose
 from easynav.faulty.fault_injector import FaultInjector
-from easynav.faulty.parameters import finite_parameter
 
 
 class FaultyLocalizer(LocalizerMethodBase):
@@ -33,8 +33,7 @@ class FaultyLocalizer(LocalizerMethodBase):
                         now: a finite, fresh but wrong pose
     =================== =========================================================================
 
-    Parameters (``<alias>.``): ``x``, ``y`` (m, 0.0), ``yaw`` (rad, 0.0), ``jump_distance``
-    (m, 1.0), ``fault`` ("none"), ``fault_after`` (10), ``hang_time`` (s, 1.0).
+    Parameters: :attr:`PARAMETERS`.
 
     Thread contract: ``initialize`` in the configuring thread; ``update_rt`` in the RT thread,
     ``update`` in the non-RT thread.
@@ -43,6 +42,14 @@ class FaultyLocalizer(LocalizerMethodBase):
     """
 
     FAULTS = ("throw", "hang", "freeze", "stop_publishing", "nan", "jump")
+    PARAMETERS = (
+        Param("x", 0.0, "the fixed pose: x", "m"),
+        Param("y", 0.0, "the fixed pose: y", "m"),
+        Param("yaw", 0.0, "the fixed pose: yaw", "rad"),
+        Param("jump_distance", 1.0, "how far the jump fault moves the pose", "m"),
+        *FaultInjector.parameters(FAULTS),
+    )
+    WRITES = (ROBOT_POSE,)
 
     def __init__(self) -> None:
         super().__init__()
@@ -54,14 +61,14 @@ class FaultyLocalizer(LocalizerMethodBase):
         self.last_stamp: float | None = None
 
     def on_initialize(self) -> None:
-        self.x = finite_parameter(self, "x", 0.0, "m, the fixed pose")
-        self.y = finite_parameter(self, "y", 0.0, "m, the fixed pose")
-        self.yaw = finite_parameter(self, "yaw", 0.0, "rad, the fixed pose")
-        self.jump_distance = finite_parameter(
-            self, "jump_distance", 1.0, "m, how far the jump fault moves the pose"
-        )
+        self.on_parameter_changed("", None)
         self.injector.read_parameters()
         self.last_stamp = None
+
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """The pose and jump distance apply from the next update."""
+        p = self.params
+        self.x, self.y, self.yaw, self.jump_distance = p.x, p.y, p.yaw, p.jump_distance
 
     def update_rt(self, nav_state: NavState) -> None:
         fault = self.injector.update()
@@ -86,7 +93,7 @@ class FaultyLocalizer(LocalizerMethodBase):
             self.last_stamp = now
         tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
         nav_state.set(
-            "robot_pose",
+            ROBOT_POSE,
             Odometry(
                 header=Header(stamp, tf_info.map_frame),
                 child_frame_id=tf_info.robot_footprint_frame,

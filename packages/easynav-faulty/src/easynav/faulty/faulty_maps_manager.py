@@ -14,7 +14,7 @@ class FaultyMapsManager(MapsManagerBase):
     ``throw`` (``update`` raises :class:`InjectedFaultError`) and ``hang`` (``update`` blocks
     ``hang_time`` s: the non-RT cycle stalls, the RT cycle must not).
 
-    Parameters (``<alias>.``): ``fault`` ("none"), ``fault_after`` (10), ``hang_time`` (s, 1.0).
+    Parameters: :attr:`PARAMETERS`.
 
     Thread contract: ``initialize`` in the configuring thread; ``update`` in the non-RT thread.
     Exceptions: :class:`PluginConfigurationError` naming the parameter; ``update`` raises
@@ -22,6 +22,7 @@ class FaultyMapsManager(MapsManagerBase):
     """
 
     FAULTS = ("throw", "hang")
+    PARAMETERS = FaultInjector.parameters(FAULTS)
 
     def __init__(self) -> None:
         super().__init__()

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from easynav.core.nav_state import NavState
+from easynav.core.nav_state_keys import GOALS, PATH, ROBOT_POSE
 from easynav.core.plugins import PlannerMethodBase
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Goals, Header, Odometry, Path, Pose
@@ -55,7 +56,7 @@ class FaultyPlanner(PlannerMethodBase):
                    NaN pose when there is no plan)
     ============== ===============================================================================
 
-    Parameters (``<alias>.``): ``fault`` ("none"), ``fault_after`` (10), ``hang_time`` (s, 1.0).
+    Parameters: :attr:`PARAMETERS`.
 
     Thread contract: ``initialize`` in the configuring thread; ``update`` in the non-RT thread.
     Exceptions: :class:`PluginConfigurationError` naming the parameter; ``update`` raises
@@ -63,6 +64,9 @@ class FaultyPlanner(PlannerMethodBase):
     """
 
     FAULTS = ("throw", "hang", "empty_path", "freeze", "nan")
+    PARAMETERS = FaultInjector.parameters(FAULTS)
+    READS = (GOALS, ROBOT_POSE)
+    WRITES = (PATH,)
 
     def __init__(self) -> None:
         super().__init__()
@@ -82,12 +86,12 @@ class FaultyPlanner(PlannerMethodBase):
         map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
         header = Header(self.now(), map_frame)
         if fault == "empty_path":
-            nav_state.set("path", Path(header, []))
+            nav_state.set(PATH, Path(header, []))
             return
         if fault == "freeze":
             if self.last_path is None:
                 self.last_path = Path(header, [])  # frozen from the first update
-            nav_state.set("path", self.last_path)
+            nav_state.set(PATH, self.last_path)
             return
         path = self._plan(nav_state, header)
         if fault == "nan":
@@ -98,15 +102,15 @@ class FaultyPlanner(PlannerMethodBase):
                 path.poses.append(Pose(math.nan, math.nan))
         else:
             self.last_path = path
-        nav_state.set("path", path)
+        nav_state.set(PATH, path)
 
     def _plan(self, nav_state: NavState, header: Header) -> Path:
-        goals = nav_state.get_or("goals", None)
+        goals = nav_state.get_or(GOALS, None)
         if not isinstance(goals, Goals) or len(goals) == 0:
             return Path(header, [])
-        if not nav_state.has("robot_pose"):
+        if not nav_state.has(ROBOT_POSE):
             return Path(header, [])
-        robot = nav_state.get_safe("robot_pose", Odometry)  # written by the RT loop
+        robot = nav_state.get_safe(ROBOT_POSE, Odometry)  # written by the RT loop
         if not robot.pose.is_finite():
             return Path(header, [])
         return straight_path(robot.pose, goals.goals[0].pose, header)

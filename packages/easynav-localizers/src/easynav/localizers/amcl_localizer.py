@@ -8,7 +8,8 @@ import threading
 import numpy as np
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import LocalizerMethodBase, PluginConfigurationError
+from easynav.core.nav_state_keys import MAP_BASE, ROBOT_POSE, NavStateKey
+from easynav.core.plugins import LocalizerMethodBase, Param, Topic
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer
@@ -30,29 +31,37 @@ from easynav.localizers.particle_filter import (
 from easynav.maps import SimpleMap
 
 #: NavState keys.
-MAP_KEY = "map.base"
-POSE_KEY = "robot_pose"
-COVARIANCE_TRACE_KEY = "localizer.amcl.covariance_trace"
+MAP_KEY = MAP_BASE
+POSE_KEY = ROBOT_POSE
+COVARIANCE_TRACE_KEY = NavStateKey(
+    "localizer.amcl.covariance_trace", "float", "var x + var y + var yaw of the particle cloud."
+)
 #: Points at or below this height in the robot footprint frame are ground (the original's).
 MIN_POINT_Z = 0.1
 
-#: Parameters and defaults of the original.
-DEFAULTS = {
-    "num_particles": 100,
-    "initial_pose.x": 0.0,
-    "initial_pose.y": 0.0,
-    "initial_pose.yaw": 0.0,
-    "initial_pose.std_dev_xy": 0.5,
-    "initial_pose.std_dev_yaw": 0.5,
-    "reseed_freq": 1.0,
-    "noise_translation": 0.01,
-    "noise_rotation": 0.01,
-    "noise_translation_to_rotation": 0.01,
-    "min_noise_xy": 0.05,
-    "min_noise_yaw": 0.05,
+_STATIC = {"dynamic": False}  # read at configure (the cloud is drawn then)
+
+#: Parameters (defaults of the original, CATALOGUE §AMCLLocalizer).
+AMCL_PARAMETERS = (
+    Param("num_particles", 100, "number of particles", ge=1, **_STATIC),
+    Param("initial_pose.x", 0.0, "initial pose: x (map frame)", "m", **_STATIC),
+    Param("initial_pose.y", 0.0, "initial pose: y (map frame)", "m", **_STATIC),
+    Param("initial_pose.yaw", 0.0, "initial pose: yaw", "rad", **_STATIC),
+    Param("initial_pose.std_dev_xy", 0.5, "initial spread in x and y (σ)", "m", ge=0.0,
+          **_STATIC),
+    Param("initial_pose.std_dev_yaw", 0.5, "initial spread in yaw (σ)", "rad", ge=0.0,
+          **_STATIC),
+    Param("reseed_freq", 1.0, "the worse half of the cloud is redrawn at this rate", "Hz",
+          gt=0.0),
+    Param("noise_translation", 0.01, "prediction noise per metre driven", ge=0.0),
+    Param("noise_rotation", 0.01, "prediction noise per radian turned", ge=0.0),
+    Param("noise_translation_to_rotation", 0.01, "yaw noise per metre driven", ge=0.0),
+    Param("min_noise_xy", 0.05, "σ floor in x and y (reseed, initialpose)", "m", ge=0.0),
+    Param("min_noise_yaw", 0.05, "σ floor in yaw (reseed, initialpose)", "rad", ge=0.0),
     # Not in the original (which counted exact hits, sigma 0): see likelihood_field.
-    "hit_sigma": 0.2,
-}
+    Param("hit_sigma", 0.2, "a point d m from an obstacle counts exp(-d²/2σ²) of a hit (0: exact "
+          "hits only, as the original)", "m", ge=0.0),
+)
 
 
 def _xy_yaw(pose: Pose) -> tuple[float, float, float]:
@@ -73,13 +82,11 @@ class AMCLLocalizer(LocalizerMethodBase):
       below half, and every ``1/reseed_freq`` s the lower-weight half is redrawn around the
       upper half (at least ``min_noise_xy``/``min_noise_yaw`` apart).
 
-    Parameters (under ``<alias>.``, defaults of the original): ``num_particles`` (100),
-    ``initial_pose.{x, y, yaw}`` (0), ``initial_pose.std_dev_xy`` (0.5 m),
-    ``initial_pose.std_dev_yaw`` (0.5 rad), ``reseed_freq`` (1.0 Hz), ``noise_translation``,
-    ``noise_rotation``, ``noise_translation_to_rotation`` (0.01), ``min_noise_xy``,
-    ``min_noise_yaw`` (0.05). Added here: ``hit_sigma`` (0.2 m): a point ``d`` metres from the
-    nearest occupied cell counts ``exp(-d²/2σ²)`` of a hit; 0 counts only points on occupied
-    cells, as the original did (it converges more slowly and can lock onto a wrong pose).
+    Parameters: :attr:`PARAMETERS` (defaults of the original). Added here: ``hit_sigma``
+    (0.2 m): a point ``d`` metres from the nearest occupied cell counts ``exp(-d²/2σ²)`` of a
+    hit; 0 counts only points on occupied cells, as the original did (it converges more slowly
+    and can lock onto a wrong pose). The noise, reseed and ``hit_sigma`` parameters can change at
+    runtime; the particle count and the initial pose are read at configure.
 
     NavState: reads ``map.base`` (:class:`SimpleMap`) and every ungrouped
     :class:`PointPerception`; writes ``robot_pose`` (:class:`Odometry` in the map frame, child
@@ -102,6 +109,20 @@ class AMCLLocalizer(LocalizerMethodBase):
     """
 
     NEEDS_MAPS = ("simple_map",)
+    PARAMETERS = AMCL_PARAMETERS
+    TOPICS = (
+        Topic("odom", "nav_msgs/msg/Odometry", "sub", "reliable, keep last 5",
+              "wheel odometry (prediction)"),
+        Topic("initialpose", "geometry_msgs/msg/PoseWithCovarianceStamped", "sub",
+              description="resets the cloud (map frame)"),
+        Topic("<node>/<alias>/particles", "geometry_msgs/msg/PoseArray", "pub",
+              description="the cloud after each correction, while subscribed"),
+        Topic("<node>/<alias>/pose", "geometry_msgs/msg/PoseWithCovarianceStamped", "pub",
+              description="the estimate after each correction, while subscribed"),
+        Topic("/tf", "tf2_msgs/msg/TFMessage", "pub", description="map → odom"),
+    )
+    READS = (MAP_BASE,)
+    WRITES = (ROBOT_POSE, COVARIANCE_TRACE_KEY)
 
     def __init__(self) -> None:
         super().__init__()
@@ -124,27 +145,9 @@ class AMCLLocalizer(LocalizerMethodBase):
     def on_initialize(self) -> None:
         self._destroy_ros()
         alias = self.plugin_name
-        v = {name: self._number(name, default) for name, default in DEFAULTS.items()}
-        num = v["num_particles"]
-        if num != int(num) or num < 1:
-            raise PluginConfigurationError(f"{alias}.num_particles = {num} must be an integer >= 1")
-        for name in DEFAULTS:
-            if name.startswith(("noise_", "min_noise_", "initial_pose.std")) and v[name] < 0.0:
-                raise PluginConfigurationError(f"{alias}.{name} = {v[name]} must be >= 0")
-        if v["reseed_freq"] <= 0.0:
-            raise PluginConfigurationError(f"{alias}.reseed_freq = {v['reseed_freq']} must be > 0")
-        self.num_particles = int(num)
-        self.reseed_period = 1.0 / v["reseed_freq"]
-        self.noise = (
-            v["noise_translation"],
-            v["noise_rotation"],
-            v["noise_translation_to_rotation"],
-        )
-        self.min_noise_xy = v["min_noise_xy"]
-        self.min_noise_yaw = v["min_noise_yaw"]
-        if v["hit_sigma"] < 0.0:
-            raise PluginConfigurationError(f"{alias}.hit_sigma = {v['hit_sigma']} must be >= 0")
-        self.hit_sigma = v["hit_sigma"]
+        v = self.params
+        self.num_particles = v.num_particles
+        self._apply_tuning()
         self._field_map = None
         self._field = None
         with self._lock:
@@ -173,17 +176,20 @@ class AMCLLocalizer(LocalizerMethodBase):
     def on_cleanup(self) -> None:
         self._destroy_ros()
 
-    def _number(self, name: str, default: float) -> float:
-        value = self.get_parameter(name, default)
-        try:
-            value = float(value)
-        except (TypeError, ValueError):
-            raise PluginConfigurationError(
-                f"{self.plugin_name}.{name} = {value!r} is not a number"
-            ) from None
-        if not math.isfinite(value):
-            raise PluginConfigurationError(f"{self.plugin_name}.{name} = {value} is not finite")
-        return value
+    def _apply_tuning(self) -> None:
+        # Derived from the parameters that may change at runtime; each a single assignment.
+        v = self.params
+        self.reseed_period = 1.0 / v.reseed_freq
+        self.noise = (v.noise_translation, v.noise_rotation, v.noise_translation_to_rotation)
+        self.min_noise_xy = v.min_noise_xy
+        self.min_noise_yaw = v.min_noise_yaw
+        self.hit_sigma = v.hit_sigma
+
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """Noise, reseed rate and ``hit_sigma`` apply from the next update."""
+        self._apply_tuning()
+        if name == "hit_sigma":
+            self._field_map = None  # the likelihood field is rebuilt with the new sigma
 
     # -- inputs -------------------------------------------------------------------------------
     def set_odometry(self, odometry: Odometry) -> None:

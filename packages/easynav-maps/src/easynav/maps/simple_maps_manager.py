@@ -9,7 +9,8 @@ import cv2
 import numpy as np
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import MapsManagerBase, PluginConfigurationError
+from easynav.core.nav_state_keys import MAP, MAP_BASE, MAP_TIME
+from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError, Topic
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer
@@ -37,14 +38,13 @@ def near_obstacles(world: SimpleMap, distance: float) -> np.ndarray:
 class SimpleMapsManager(MapsManagerBase):
     """Loads a :class:`SimpleMap` and keeps a copy with the live obstacles.
 
-    Parameters (under ``<alias>.``): ``package`` and ``map_path_file`` (see
-    :func:`easynav.maps.resolve_map_file`; with ``package`` empty, ``map_path_file`` is a path;
-    a ``.yaml`` file is loaded as a ROS map_server map), ``save_map_path`` (where ``savemap``
-    writes; empty: the loaded file when it was given as a plain path, else ``/tmp/default.map``),
-    ``static_obstacle_tolerance`` (0.1 m: a point this close to an occupied cell of the static
-    map is that obstacle seen with localisation and range noise, and is not marked again; the
-    original marked it, thickening walls by a cell, which on the planner's coarse grid can close
-    a door; 0 marks every point).
+    Parameters: :attr:`PARAMETERS`. ``package`` and ``map_path_file``: see
+    :func:`easynav.maps.resolve_map_file` (with ``package`` empty, ``map_path_file`` is a path;
+    a ``.yaml`` file is loaded as a ROS map_server map). ``save_map_path`` empty: the loaded file
+    when it was given as a plain path, else ``/tmp/default.map``. ``static_obstacle_tolerance``:
+    a point this close to an occupied cell of the static map is that obstacle seen with
+    localisation and range noise, and is not marked again (the original marked it, thickening
+    walls by a cell, which on the planner's coarse grid can close a door; 0 marks every point).
     With neither ``package`` nor ``map_path_file`` set, no map is loaded and the manager waits for
     one on ``incoming_map``.
 
@@ -67,6 +67,25 @@ class SimpleMapsManager(MapsManagerBase):
     """
 
     PROVIDES_MAPS = ("simple_map",)
+    PARAMETERS = (
+        Param("package", "", "package holding the map (empty: map_path_file is a path)",
+              dynamic=False),
+        Param("map_path_file", "", "map file inside the package, or a path (.map or .yaml)",
+              dynamic=False),
+        Param("save_map_path", "", "where savemap writes the map (.map)", dynamic=False),
+        Param("static_obstacle_tolerance", 0.1,
+              "points this close to the static map's obstacles are not marked again", "m",
+              ge=0.0),
+    )
+    TOPICS = (
+        Topic("<node>/<alias>/map", "nav_msgs/msg/OccupancyGrid", "pub", "latched",
+              "the static map"),
+        Topic("<node>/<alias>/dynamic_map", "nav_msgs/msg/OccupancyGrid", "pub",
+              description="the map with live obstacles, each update while subscribed"),
+        Topic("<node>/<alias>/incoming_map", "nav_msgs/msg/OccupancyGrid", "sub",
+              description="replaces both maps"),
+    )
+    WRITES = (MAP_BASE, MAP, MAP_TIME)
 
     def __init__(self) -> None:
         super().__init__()
@@ -83,27 +102,10 @@ class SimpleMapsManager(MapsManagerBase):
     def on_initialize(self) -> None:
         self._destroy_ros()
         alias = self.plugin_name
-        package = str(self.get_parameter("package", "", "package holding the map (empty: path)"))
-        map_path_file = str(
-            self.get_parameter("map_path_file", "", "map file inside package, or a path")
-        )
-        save_map_path = str(
-            self.get_parameter("save_map_path", "", "where savemap writes the map (.map)")
-        )
-        tolerance = self.get_parameter(
-            "static_obstacle_tolerance", 0.1, "points this close to the static map are not marked"
-        )
-        try:
-            tolerance = float(tolerance)
-        except (TypeError, ValueError):
-            raise PluginConfigurationError(
-                f"{alias}.static_obstacle_tolerance = {tolerance!r} is not a number"
-            ) from None
-        if not math.isfinite(tolerance) or tolerance < 0.0:
-            raise PluginConfigurationError(
-                f"{alias}.static_obstacle_tolerance = {tolerance} must be finite and >= 0"
-            )
-        self._tolerance = tolerance
+        package = self.params.package
+        map_path_file = self.params.map_path_file
+        save_map_path = self.params.save_map_path
+        self._tolerance = self.params.static_obstacle_tolerance
         self._explained_for = None
         self._static_map = None
         self._map_file = None
@@ -137,6 +139,12 @@ class SimpleMapsManager(MapsManagerBase):
             self._save_path = DEFAULT_SAVE_PATH
         if self.context.node is not None:
             self._create_ros()
+
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """``static_obstacle_tolerance`` applies from the next update."""
+        if name == "static_obstacle_tolerance":
+            self._tolerance = float(value)
+            self._explained_for = None  # recomputed with the new distance
 
     def on_cleanup(self) -> None:
         self._destroy_ros()
@@ -208,9 +216,9 @@ class SimpleMapsManager(MapsManagerBase):
                 self.logger, "no-perceptions", f"{self.plugin_name}: no point perceptions"
             )
         now = self.now()
-        nav_state.set("map.base", static)
-        nav_state.set("map", dynamic)
-        nav_state.set("map_time", float(now))
+        nav_state.set(MAP_BASE, static)
+        nav_state.set(MAP, dynamic)
+        nav_state.set(MAP_TIME, float(now))
         self._publish_dynamic(dynamic, tf_info.map_frame, now)
 
     # -- ROS ----------------------------------------------------------------------------------

@@ -6,8 +6,8 @@ import math
 
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import PlannerMethodBase, PluginConfigurationError
-from easynav.core.robot import RobotGeometry
+from easynav.core.nav_state_keys import DIAGNOSTICS_PATH, GOALS, MAP, MAP_BASE, PATH, ROBOT_POSE
+from easynav.core.plugins import Param, PlannerMethodBase, PluginConfigurationError, Topic
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Goals, Header, Odometry, Path
@@ -15,9 +15,9 @@ from easynav.maps import SimpleMap
 from easynav.planners.simple_grid_planner import SimpleGridPlanner
 
 #: NavState keys.
-MAP_KEY = "map"
-STATIC_MAP_KEY = "map.base"
-PATH_KEY = "path"
+MAP_KEY = MAP
+STATIC_MAP_KEY = MAP_BASE
+PATH_KEY = PATH
 #: The planner's diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
 DIAGNOSTIC_NAME = "path"
 HARDWARE_ID = "planner"
@@ -26,10 +26,10 @@ HARDWARE_ID = "planner"
 class SimplePlanner(PlannerMethodBase):
     """Plans to the first goal with :class:`SimpleGridPlanner` on NavState ``map``.
 
-    Parameters (under ``<alias>.``): ``clearance_distance`` (0.2 m), ``robot_radius``
-    (deprecated: ``system_node.robot_geometry.radius`` is used unless this is set; set, it
-    applies with a warning only where robot_geometry keeps its default radius), ``smooth_path``
-    (True: line-of-sight shortcuts; False: the raw 8-connected cell path, as the original).
+    Parameters: :attr:`PARAMETERS`. ``robot_radius`` is deprecated: the robot's radius is
+    ``system_node.robot_geometry.radius``; set, ``robot_radius`` applies (with a warning) only
+    where the params file does not set ``robot_geometry.radius`` (robot_geometry takes
+    precedence when both are set, whatever its value).
 
     NavState: reads ``goals`` (:class:`Goals`, plans to the first), ``robot_pose``
     (:class:`Odometry`), ``map`` (:class:`SimpleMap`, with live obstacles); writes ``path``
@@ -49,6 +49,18 @@ class SimplePlanner(PlannerMethodBase):
     """
 
     NEEDS_MAPS = ("simple_map",)
+    PARAMETERS = (
+        Param("clearance_distance", 0.2, "extra distance kept from obstacles beyond the radius",
+              "m", ge=0.0),
+        Param("robot_radius", math.nan, "deprecated: system_node robot_geometry.radius", "m",
+              ge=0.0, allow_nan=True),
+        Param("smooth_path", True,
+              "shorten the A* path by line of sight (false: the raw 8-connected cell path)"),
+    )
+    TOPICS = (Topic("<node>/<alias>/path", "nav_msgs/msg/Path", "pub",
+                    description="the path, while subscribed"),)
+    READS = (GOALS, ROBOT_POSE, MAP, MAP_BASE)
+    WRITES = (PATH, DIAGNOSTICS_PATH)
 
     def __init__(self) -> None:
         super().__init__()
@@ -60,13 +72,7 @@ class SimplePlanner(PlannerMethodBase):
     def on_initialize(self) -> None:
         self._destroy_publisher()
         alias = self.plugin_name
-        clearance = self._distance("clearance_distance", 0.2)
-        radius = self._robot_radius()
-        smooth = self.get_parameter("smooth_path", True, "shorten the A* path by line of sight")
-        try:
-            self.planner = SimpleGridPlanner(radius, clearance, smooth=bool(smooth))
-        except ValueError as exc:
-            raise PluginConfigurationError(f"{alias}: {exc}") from None
+        self.planner = self._make_planner()
         self._last_status = None
         node = self.context.node
         if node is not None:
@@ -83,28 +89,26 @@ class SimplePlanner(PlannerMethodBase):
             self.context.node.destroy_publisher(self._publisher)
         self._publisher = None
 
-    def _distance(self, name: str, default: float) -> float:
-        value = self.get_parameter(name, default)
+    def _make_planner(self) -> SimpleGridPlanner:
         try:
-            value = float(value)
-        except (TypeError, ValueError):
-            raise PluginConfigurationError(
-                f"{self.plugin_name}.{name} = {value!r} is not a number"
-            ) from None
-        if not math.isfinite(value) or value < 0.0:
-            raise PluginConfigurationError(
-                f"{self.plugin_name}.{name} = {value} must be finite and >= 0"
+            return SimpleGridPlanner(
+                self._robot_radius(), self.params.clearance_distance,
+                smooth=self.params.smooth_path,
             )
-        return value
+        except ValueError as exc:
+            raise PluginConfigurationError(f"{self.plugin_name}: {exc}") from None
+
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """A new grid planner with the changed parameter, used from the next update."""
+        self.planner = self._make_planner()
 
     def _robot_radius(self) -> float:
         geometry = self.get_robot_geometry()
-        # NaN means "not set": the deprecated parameter only counts when a user sets it.
-        legacy = self._distance_or_nan("robot_radius")
+        legacy = self.params.robot_radius  # NaN: not set
         if math.isnan(legacy):
             return geometry.radius
         name = f"{self.plugin_name}.robot_radius"
-        if geometry.radius != RobotGeometry().radius:
+        if geometry.is_set("radius"):
             self.logger.warning(
                 f"{name} is deprecated and ignored: system_node.robot_geometry.radius = "
                 f"{geometry.radius:g} takes precedence"
@@ -115,29 +119,13 @@ class SimplePlanner(PlannerMethodBase):
         )
         return legacy
 
-    def _distance_or_nan(self, name: str) -> float:
-        value = self.get_parameter(name, math.nan, "deprecated: robot_geometry.radius")
-        try:
-            value = float(value)
-        except (TypeError, ValueError):
-            raise PluginConfigurationError(
-                f"{self.plugin_name}.{name} = {value!r} is not a number"
-            ) from None
-        if math.isnan(value):
-            return value
-        if not math.isfinite(value) or value < 0.0:
-            raise PluginConfigurationError(
-                f"{self.plugin_name}.{name} = {value} must be finite and >= 0"
-            )
-        return value
-
     # -- update -------------------------------------------------------------------------------
     def update(self, nav_state: NavState) -> None:
         """Plan to the first goal and write ``path``. Non-RT thread."""
-        if not nav_state.has("goals"):
+        if not nav_state.has(GOALS):
             return
         map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
-        goals = nav_state.get("goals", Goals)
+        goals = nav_state.get(GOALS, Goals)
         if len(goals) == 0:
             self._write(nav_state, Path(Header(self.now(), map_frame)), None, "idle: no goal")
             return
@@ -157,10 +145,10 @@ class SimplePlanner(PlannerMethodBase):
                 self.reject_goal(problem)
                 self._fail(nav_state, map_frame, problem)
                 return
-        if not nav_state.has("robot_pose"):
+        if not nav_state.has(ROBOT_POSE):
             self._fail(nav_state, map_frame, f"{goal_text}: no robot_pose yet")
             return
-        robot = nav_state.get("robot_pose", Odometry)
+        robot = nav_state.get(ROBOT_POSE, Odometry)
         if not robot.is_finite():
             self._fail(nav_state, map_frame, f"{goal_text}: robot_pose is not finite")
             return

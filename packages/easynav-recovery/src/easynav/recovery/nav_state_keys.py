@@ -16,18 +16,23 @@ from easynav.core.nav_state_keys import (  # noqa: F401  (re-exported)
     RECONFIGURED_PARAMETERS,
     ROBOT_POSE,
     SAFETY_STATUS,
+    NavStateKey,
+)
+from easynav.core.nav_state_keys import CONTROL_OWNER as CORE_CONTROL_OWNER
+
+AMCL_COVARIANCE_TRACE = NavStateKey(
+    "localizer.amcl.covariance_trace", "float", "var x + var y + var yaw of the particle cloud."
 )
 
-AMCL_COVARIANCE_TRACE = "localizer.amcl.covariance_trace"
-"""float: var x + var y + var yaw of the AMCL particle cloud."""
+SENSORS_DIAGNOSTIC = NavStateKey(
+    "diagnostics.sensors",
+    "DiagnosticStatus",
+    'sensors_node\'s diagnostic; values["no_data"] lists the sensors without data yet.',
+)
 
-SENSORS_DIAGNOSTIC = "diagnostics.sensors"
-"""DiagnosticStatus of sensors_node; ``values["no_data"]`` lists the sensors without data yet."""
-
-
-CONTROL_OWNER = "control_owner"
-"""str: "controller", or "recovery:<alias>" while a mitigation drives the robot (the
-DiagnosticRecoveryManager writes it; evaluators that watch the controller read it)."""
+#: "controller", or "recovery:<alias>" while a mitigation drives the robot (the
+#: DiagnosticRecoveryManager writes it; evaluators that watch the controller read it).
+CONTROL_OWNER = CORE_CONTROL_OWNER
 
 CONTROLLER_OWNS_CONTROL = "controller"
 """Value of :data:`CONTROL_OWNER` when no mitigation drives the robot."""

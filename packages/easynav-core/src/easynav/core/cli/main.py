@@ -39,11 +39,20 @@ def build_parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="configure without starting: report what is wrong")
     check.add_argument("params")
     check.add_argument("--namespace", default="")
+    check.add_argument(
+        "--strict", action="store_true",
+        help="a key no plugin declares is an error (default: a warning)",
+    )
 
     plugins = sub.add_parser("plugins", help="list installed plugins by kind")
     plugins.add_argument(
         "--import", dest="do_import", action="store_true",
         help="also import every plugin and report those that fail",
+    )
+    plugins.add_argument(
+        "--describe", metavar="NAME", default=None,
+        help="a plugin's parameters (name, type, default, unit, range, description), topics "
+             "and NavState keys read and written",
     )
 
     goal = sub.add_parser("goal", help="send a goal to a running EasyNav and follow it")
@@ -54,7 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _load_params_or_exit(path: str) -> None:
+def _load_params_or_exit(path: str) -> dict:
     try:
         document = load_params_file(path)
     except ParamsFileError as exc:
@@ -62,6 +71,18 @@ def _load_params_or_exit(path: str) -> None:
         raise SystemExit(2) from None
     for name in unknown_node_names(document):
         print(f"easynav: warning: '{name}' in {path} is not an EasyNav node", file=sys.stderr)
+    return document
+
+
+def _report_unknown_keys(path: str, document: dict, strict: bool) -> int:
+    """Print each key nothing declares; the number found."""
+    from easynav.core.cli.unknown_keys import unknown_keys
+
+    found = unknown_keys(document)
+    level = "error" if strict else "warning"
+    for item in found:
+        print(f"easynav: {level}: {path}: {item.message()}", file=sys.stderr)
+    return len(found)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -89,7 +110,10 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    _load_params_or_exit(args.params)
+    document = _load_params_or_exit(args.params)
+    if _report_unknown_keys(args.params, document, args.strict) and args.strict:
+        print("easynav: configuration invalid: unknown parameters (--strict)", file=sys.stderr)
+        return 2
     # Nothing here needs the network: keep DDS discovery inside this process.
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
     from easynav.core.system.easynav_runtime import EasyNavRuntime
@@ -112,6 +136,16 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_plugins(args: argparse.Namespace) -> int:
+    if args.describe:
+        from easynav.core.plugins.plugin_reference import describe_text, find_plugin
+
+        try:
+            plugin = find_plugin(args.describe)
+        except (LookupError, ImportError) as exc:
+            print(f"easynav: {exc}", file=sys.stderr)
+            return 2
+        print(describe_text(plugin))
+        return 0
     from easynav.core.plugins.discovery import check_imports, list_plugins, other_plugin_groups
     from easynav.core.plugins.plugin_kinds import ALL_KINDS
 

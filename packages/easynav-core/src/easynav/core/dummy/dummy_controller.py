@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from easynav.core.dummy.busy_wait import busy_wait
+from easynav.core.dummy.dummy_parameters import CYCLE_TIME_RT
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import ControllerMethodBase
 
@@ -10,8 +11,7 @@ from easynav.core.plugins import ControllerMethodBase
 class DummyController(ControllerMethodBase):
     """Computes no command. Parameters: ``cycle_time_rt`` (s, busy-wait per RT update, 0.0)."""
 
-    def on_initialize(self) -> None:
-        self.cycle_time_rt = float(self.get_parameter("cycle_time_rt", 0.0))
+    PARAMETERS = (CYCLE_TIME_RT,)
 
     def update_rt(self, nav_state: NavState) -> None:
-        busy_wait(self.cycle_time_rt)
+        busy_wait(self.params.cycle_time_rt)

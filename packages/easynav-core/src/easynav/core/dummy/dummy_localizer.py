@@ -3,19 +3,23 @@
 from __future__ import annotations
 
 from easynav.core.dummy.busy_wait import busy_wait
+from easynav.core.dummy.dummy_parameters import CYCLE_TIME_NORT, CYCLE_TIME_RT
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import LocalizerMethodBase
+from easynav.core.plugins import LocalizerMethodBase, Param
 
 
 class DummyLocalizer(LocalizerMethodBase):
     """Estimates no pose. Parameters: ``cycle_time_rt`` and ``cycle_time_nort`` (s, 0.0)."""
 
-    def on_initialize(self) -> None:
-        self.cycle_time_rt = float(self.get_parameter("cycle_time_rt", 0.0))
-        self.cycle_time_nort = float(self.get_parameter("cycle_time_nort", 0.0))
+    PARAMETERS = (
+        CYCLE_TIME_RT,
+        CYCLE_TIME_NORT,
+        # In the original's Dummy file (seed-design); a Dummy localizer has nothing to reseed.
+        Param("reseed_freq", 1.0, "accepted for files written for AMCL; unused", "Hz", gt=0.0),
+    )
 
     def update_rt(self, nav_state: NavState) -> None:
-        busy_wait(self.cycle_time_rt)
+        busy_wait(self.params.cycle_time_rt)
 
     def update(self, nav_state: NavState) -> None:
-        busy_wait(self.cycle_time_nort)
+        busy_wait(self.params.cycle_time_nort)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from easynav.core.dummy.busy_wait import busy_wait
+from easynav.core.dummy.dummy_parameters import CYCLE_TIME_NORT
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PlannerMethodBase
 
@@ -10,8 +11,7 @@ from easynav.core.plugins import PlannerMethodBase
 class DummyPlanner(PlannerMethodBase):
     """Plans nothing. Parameters: ``cycle_time_nort`` (s, busy-wait per update, 0.0)."""
 
-    def on_initialize(self) -> None:
-        self.cycle_time_nort = float(self.get_parameter("cycle_time_nort", 0.0))
+    PARAMETERS = (CYCLE_TIME_NORT,)
 
     def update(self, nav_state: NavState) -> None:
-        busy_wait(self.cycle_time_nort)
+        busy_wait(self.params.cycle_time_nort)

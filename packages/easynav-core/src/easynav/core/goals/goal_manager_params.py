@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-import math
 import sys
 from dataclasses import dataclass
 from typing import Any
+
+from easynav.core.plugins.declarations import Param, ParameterValueError, read_parameters
 
 LARGEST_FINITE_DOUBLE = sys.float_info.max
 """Default ``height_tolerance``: the original's ``std::numeric_limits<double>::max()``."""
@@ -28,26 +29,22 @@ class GoalManagerParams:
     update_frequency: float = 20.0
 
     def __post_init__(self) -> None:
-        for name in ("position_tolerance", "height_tolerance", "angle_tolerance"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise TypeError(f"goal manager parameter '{name}' must be a number, got {value!r}")
-            if math.isnan(value) or value < 0.0:
-                raise ValueError(f"goal manager parameter '{name}' must be >= 0, got {value!r}")
-        freq = self.update_frequency
-        if isinstance(freq, bool) or not isinstance(freq, int | float):
-            raise TypeError(
-                f"goal manager parameter 'update_frequency' must be a number, got {freq!r}"
-            )
-        if not (math.isfinite(freq) and freq > 0.0):
-            raise ValueError(
-                f"goal manager parameter 'update_frequency' must be finite and > 0, got {freq!r}"
-            )
-        if not isinstance(self.allow_preempt_goal, bool):
-            raise TypeError(
-                "goal manager parameter 'allow_preempt_goal' must be a bool, "
-                f"got {self.allow_preempt_goal!r}"
-            )
+        for param in GOAL_MANAGER_PARAMETERS:
+            value = getattr(self, param.name)
+            if param.type == "float" and (isinstance(value, bool) or not isinstance(
+                value, int | float
+            )):
+                raise TypeError(
+                    f"goal manager parameter '{param.name}' must be a number, got {value!r}"
+                )
+            if param.type == "bool" and not isinstance(value, bool):
+                raise TypeError(
+                    f"goal manager parameter '{param.name}' must be a bool, got {value!r}"
+                )
+            try:
+                param.convert(value, f"goal manager parameter '{param.name}'")
+            except ParameterValueError as exc:
+                raise ValueError(str(exc)) from None
 
     @property
     def feedback_period(self) -> float:
@@ -60,14 +57,19 @@ class GoalManagerParams:
         :class:`easynav.core.plugins.ParameterAccess` (system_node's, or ``DictParameters``).
 
         Thread contract: the caller's (system_node configure, non-RT thread).
-        Raises ``ValueError`` / ``TypeError`` naming the offending parameter.
+        Raises ``ValueError`` naming the offending parameter, its value and the rule.
         """
-        defaults = cls()
-        names = (
-            "allow_preempt_goal",
-            "position_tolerance",
-            "height_tolerance",
-            "angle_tolerance",
-            "update_frequency",
-        )
-        return cls(**{name: parameters.declare(name, getattr(defaults, name)) for name in names})
+        values = read_parameters(GOAL_MANAGER_PARAMETERS, parameters, "")
+        return cls(**dict(values))
+
+
+#: The goal manager's parameters on system_node (REFERENCE.md §1, original defaults).
+GOAL_MANAGER_PARAMETERS = (
+    Param("allow_preempt_goal", True, "a new goal while navigating replaces the mission"),
+    Param("position_tolerance", 0.03, "a goal is reached within this distance (xy)", "m",
+          ge=0.0),
+    Param("height_tolerance", LARGEST_FINITE_DOUBLE, "... and this height difference (z)", "m",
+          ge=0.0),
+    Param("angle_tolerance", 0.01, "... and this yaw difference", "rad", ge=0.0),
+    Param("update_frequency", 20.0, "most feedback messages per second", "Hz", gt=0.0),
+)

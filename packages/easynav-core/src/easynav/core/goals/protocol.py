@@ -6,6 +6,12 @@ on them, so they are kept byte for byte (including the table's capitalisation).
 
 from __future__ import annotations
 
+from easynav.core.nav_state_keys import (
+    GOAL_TOLERANCE_HEIGHT,
+    GOAL_TOLERANCE_POSITION,
+    GOAL_TOLERANCE_YAW,
+)
+
 # -- participants -------------------------------------------------------------------------------
 SYSTEM_USER_ID = "easynav_system"
 """The goal manager's own id: it ignores messages carrying it."""
@@ -45,9 +51,9 @@ KEY_NAVIGATION_STATE = "navigation_state"
 KEY_NAVIGATION_PAUSED = "navigation_paused"
 KEY_ROBOT_POSE = "robot_pose"
 KEY_PATH = "path"
-KEY_POSITION_TOLERANCE = "goal_tolerance.position"
-KEY_HEIGHT_TOLERANCE = "goal_tolerance.height"
-KEY_YAW_TOLERANCE = "goal_tolerance.yaw"
+KEY_POSITION_TOLERANCE = GOAL_TOLERANCE_POSITION
+KEY_HEIGHT_TOLERANCE = GOAL_TOLERANCE_HEIGHT
+KEY_YAW_TOLERANCE = GOAL_TOLERANCE_YAW
 
 NAVIGATION_IDLE = "IDLE"
 """Value of NavState ``navigation_state`` (a ``str``) when there is no mission."""

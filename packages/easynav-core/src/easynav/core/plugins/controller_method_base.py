@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import math
+
 from easynav.core.nav_state import NavState
+from easynav.core.plugins.declarations import Param
 from easynav.core.plugins.method_base import MethodBase
 from easynav.core.robot import RobotLimits
 
@@ -16,6 +19,26 @@ class ControllerMethodBase(MethodBase):
     """
 
     HAS_RT_UPDATE = True
+
+    #: The original controllers' own limits, deprecated in favour of
+    #: ``controller_node.robot_limits.*``: unset (NaN) by default; set, controller_node applies
+    #: each to the robot_limits field it stands for where the user did not set that field
+    #: (explicit robot_limits and runtime changes win). Controllers use only
+    #: :meth:`get_robot_limits`.
+    DEPRECATED_PARAMETERS = (
+        Param("max_linear_speed", math.nan,
+              "deprecated: controller_node robot_limits.max_linear_vel", "m/s", ge=0.0,
+              allow_nan=True, dynamic=False),
+        Param("max_angular_speed", math.nan,
+              "deprecated: controller_node robot_limits.max_angular_vel", "rad/s", ge=0.0,
+              allow_nan=True, dynamic=False),
+        Param("max_linear_acc", math.nan,
+              "deprecated: controller_node robot_limits.max_linear_acc", "m/s²", ge=0.0,
+              allow_nan=True, dynamic=False),
+        Param("max_angular_acc", math.nan,
+              "deprecated: controller_node robot_limits.max_angular_acc", "rad/s²", ge=0.0,
+              allow_nan=True, dynamic=False),
+    )
 
     def update_rt(self, nav_state: NavState) -> None:
         """Compute the command. RT thread. Exceptions are contained (the robot brakes)."""

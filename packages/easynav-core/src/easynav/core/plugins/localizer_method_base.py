@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins.declarations import Topic
 from easynav.core.plugins.method_base import MethodBase
 from easynav.core.plugins.plugin_context import PluginContext
 from easynav.core.tf import get_tf_buffer
@@ -37,6 +38,11 @@ class LocalizerMethodBase(MethodBase):
 
     HAS_RT_UPDATE = True
     HAS_UPDATE = True
+    #: Every localizer's subscription (a subclass listing its own topics keeps this one).
+    TOPICS = (
+        Topic(INITIAL_POSE_TOPIC, "geometry_msgs/msg/PoseWithCovarianceStamped", "sub",
+              description="a pose to reset to (map frame)"),
+    )
 
     def __init__(self) -> None:
         super().__init__()

@@ -4,14 +4,8 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-from easynav.core.plugins.declarations import (
-    Param,
-    ParameterValueError,
-    ParameterValues,
-    Topic,
-    merge_declarations,
-    read_parameters,
-)
+from easynav.core.plugins.declarations import Param, ParameterValueError, ParameterValues, Topic
+from easynav.core.plugins.parameter_owner import ParameterOwner
 from easynav.core.plugins.plugin_context import PluginContext
 from easynav.core.plugins.rate_monitor import RateMonitor
 from easynav.core.plugins.rate_schedule import RateSchedule
@@ -29,7 +23,7 @@ COMMON_PARAMETERS = (
 )
 
 
-class MethodBase:
+class MethodBase(ParameterOwner):
     """Base of every plugin.
 
     A plugin declares its parameters once, as data, in ``PARAMETERS`` (see
@@ -54,6 +48,7 @@ class MethodBase:
     #: The plugin's own parameters (see :class:`Param`); a subclass's replace its bases' of the
     #: same name. ``rt_freq`` and ``freq`` are common to every plugin.
     PARAMETERS: ClassVar[tuple[Param, ...]] = ()
+    BASE_PARAMETERS: ClassVar[tuple[Param, ...]] = COMMON_PARAMETERS
     #: Topics the plugin publishes or subscribes to on its host node.
     TOPICS: ClassVar[tuple[Topic, ...]] = ()
     #: NavState keys the plugin reads and writes (NavStateKey constants).
@@ -76,57 +71,32 @@ class MethodBase:
         self.rate_monitor: RateMonitor | None = None
         self.params = ParameterValues()
 
-    # -- declarations --------------------------------------------------------------------------
-    @classmethod
-    def parameter_declarations(cls) -> tuple[Param, ...]:
-        """Every parameter of this plugin class: the common ones, then each class's own
-        (base classes first; a subclass's declaration replaces a base's of the same name)."""
-        groups = [COMMON_PARAMETERS]
-        for klass in reversed(cls.__mro__):
-            own = klass.__dict__.get("PARAMETERS")
-            if own:
-                groups.append(own)
-        return merge_declarations(groups)
-
-    @classmethod
-    def parameter_declaration(cls, name: str) -> Param | None:
-        """The declaration of ``name`` (current or deprecated name), or None."""
-        for param in cls.parameter_declarations():
-            if name == param.name or name in param.deprecated:
-                return param
-        return None
-
+    # -- declarations (see ParameterOwner) ----------------------------------------------------
     def validate_parameter(self, name: str, value: Any) -> Any:
-        """A runtime change of ``<alias>.<name>`` checked against its declaration: the converted
-        value, or :class:`ParameterValueError` with the reason (the host refuses the change)."""
+        """A runtime change of ``<alias>.<name>`` checked against its declaration (and, for
+        ``rt_freq``/``freq``, against the system cycle): the converted value, or
+        :class:`ParameterValueError` with the reason (the host refuses the change)."""
+        converted = super().validate_parameter(name, value)
         param = self.parameter_declaration(name)
-        full = f"{self.plugin_name}.{name}"
-        if param is None:
-            raise ParameterValueError(f"{full}: unknown parameter")
-        if not param.dynamic:
-            raise ParameterValueError(f"{full}: cannot change at runtime (reconfigure instead)")
-        converted = param.convert(value, full)
-        if param.name in ("rt_freq", "freq"):
-            self._check_frequency(param.name, converted)
+        if param is not None and param.name in ("rt_freq", "freq"):
+            try:
+                self._check_frequency(param.name, converted)
+            except PluginConfigurationError as exc:
+                raise ParameterValueError(str(exc)) from None
         return converted
 
     def apply_parameter(self, name: str, value: Any) -> None:
-        """Store a validated runtime change and tell the plugin (:meth:`on_parameter_changed`)."""
+        """Store a validated runtime change (a new frequency restarts its schedule) and tell the
+        plugin (:meth:`on_parameter_changed`)."""
         param = self.parameter_declaration(name)
         key = param.name if param is not None else name
-        self.params.set(key, value)
         if key == "rt_freq":
             self.rt_freq = value
             self.rt_schedule = RateSchedule(value)
         elif key == "freq":
             self.freq = value
             self.schedule = RateSchedule(value)
-        self.on_parameter_changed(key, value)
-
-    def on_parameter_changed(self, name: str, value: Any) -> None:
-        """A parameter changed at runtime (already validated and stored in ``self.params``).
-        Plugins that read ``self.params`` every cycle need nothing here; those that derive
-        state from a parameter rebuild it."""
+        super().apply_parameter(name, value)
 
     # -- lifecycle ---------------------------------------------------------------------------
     def initialize(self, context: PluginContext, plugin_name: str) -> None:
@@ -134,9 +104,8 @@ class MethodBase:
         self.context = context
         self.plugin_name = plugin_name
         try:
-            self.params = read_parameters(
-                self.parameter_declarations(), context.parameters, plugin_name,
-                warn=lambda message: self.logger.warning(message),
+            self.read_declared_parameters(
+                context.parameters, plugin_name, warn=lambda message: self.logger.warning(message)
             )
         except ParameterValueError as exc:
             raise PluginConfigurationError(str(exc)) from None
@@ -195,7 +164,9 @@ class MethodBase:
 
     # -- helpers for plugins ----------------------------------------------------------------
     def get_parameter(self, name: str, default: Any, description: str = "") -> Any:
-        """Declare-if-absent ``<plugin_name>.<name>`` on the host node and return its value."""
+        """Declare-if-absent ``<plugin_name>.<name>`` on the host node and return its value,
+        unchecked. Only for keys a host reads for its sub-plugins (``<sub_alias>.plugin``):
+        a plugin's own parameters are declared in ``PARAMETERS`` and read as ``self.params``."""
         return self.context.parameters.declare(f"{self.plugin_name}.{name}", default, description)
 
     def get_robot_geometry(self) -> RobotGeometry:

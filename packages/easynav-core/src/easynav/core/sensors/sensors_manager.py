@@ -12,12 +12,18 @@ from typing import Any
 import numpy as np
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
 from easynav.core.sensors.errors import PerceptionConversionError, SensorsConfigurationError
 from easynav.core.sensors.handler_registry import resolve_handler
 from easynav.core.sensors.handlers import LaserScanHandler, PointCloud2Handler
 from easynav.core.sensors.point_perception import PointPerception
 from easynav.core.sensors.point_perceptions_ops import PointPerceptionsOps
+from easynav.core.sensors.sensor_parameters import (
+    FORGET_TIME,
+    SENSOR_IDS,
+    SENSOR_PARAMETERS,
+)
 from easynav.core.sensors.sensor_state import SensorState
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import TFBuffer, get_tf_buffer
@@ -130,31 +136,21 @@ class SensorsManager:
     def _parameter(self, name: str) -> str:
         return f"{self._node_name}.{name}"
 
-    def _read_forget_time(self, params: Any) -> float:
-        value = params.declare(
-            "forget_time", 1.0, "Maximum age (s) of a perception before it is marked invalid"
-        )
+    def _read(self, declarations: Any, params: Any, prefix: str = "") -> Any:
         try:
-            forget_time = float(value)
-        except (TypeError, ValueError):
-            raise SensorsConfigurationError(
-                f"{self._parameter('forget_time')} = {value!r} is not a number"
-            ) from None
-        if not math.isfinite(forget_time) or forget_time <= 0.0:
-            raise SensorsConfigurationError(
-                f"{self._parameter('forget_time')} = {value!r} must be finite and > 0 (seconds)"
-            )
-        return forget_time
+            return read_parameters(declarations, params, prefix, warn=self._logger.warning)
+        except ParameterValueError as exc:
+            raise SensorsConfigurationError(f"{self._node_name}.{exc}") from None
+
+    def _read_forget_time(self, params: Any) -> float:
+        return self._read((FORGET_TIME,), params).forget_time
 
     def _read_sensor_ids(self, params: Any) -> list[str]:
-        value = params.declare("sensors", [], "Sensor ids; each has <id>.topic and <id>.type")
-        if value is None:
-            return []
-        if isinstance(value, str) or not all(isinstance(v, str) and v for v in value):
+        ids = list(self._read((SENSOR_IDS,), params).sensors or [])
+        if not all(ids):
             raise SensorsConfigurationError(
-                f"{self._parameter('sensors')} = {value!r} must be a list of non-empty strings"
+                f"{self._parameter('sensors')} = {ids!r} must be a list of non-empty strings"
             )
-        ids = list(value)
         duplicated = sorted({v for v in ids if ids.count(v) > 1})
         if duplicated:
             raise SensorsConfigurationError(
@@ -163,16 +159,9 @@ class SensorsManager:
         return ids
 
     def _configure_sensor(self, params: Any, sensor_id: str) -> SensorState:
-        topic = params.declare(f"{sensor_id}.topic", "", "Topic of the sensor")
-        type_name = params.declare(f"{sensor_id}.type", "", "ROS message type, pkg/msg/Type")
-        group = params.declare(f"{sensor_id}.group", "", "Optional NavState group")
-        plugin = params.declare(f"{sensor_id}.plugin", "", "Optional perception handler plugin")
-        values = {"topic": topic, "type": type_name, "group": group, "plugin": plugin}
-        for name, v in values.items():
-            if not isinstance(v, str):
-                raise SensorsConfigurationError(
-                    f"{self._parameter(f'{sensor_id}.{name}')} = {v!r} must be a string"
-                )
+        values = self._read(SENSOR_PARAMETERS, params, sensor_id)
+        topic, type_name = values.topic, values.type
+        group, plugin = values.group, values.plugin
         if not topic:
             raise SensorsConfigurationError(
                 f"{self._parameter(f'{sensor_id}.topic')} is not set: the topic of sensor "

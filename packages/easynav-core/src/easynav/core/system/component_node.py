@@ -7,11 +7,19 @@ import time
 import traceback
 from typing import Any
 
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.plugins import MethodBase, PluginContext, RateMonitor
+from easynav.core.plugins.declarations import (
+    Param,
+    ParameterValueError,
+    ParameterValues,
+    read_parameters,
+)
 from easynav.core.plugins.discovery import load_plugin_class
+from easynav.core.plugins.parameter_owner import ParameterOwner
 from easynav.core.plugins.plugin_kinds import PluginKind
 from easynav.core.system.node_parameters import NodeParameters
 from easynav.core.system.system_context import SystemContext
@@ -44,7 +52,19 @@ class ComponentNode(LifecycleNode):
     thread); ``cycle_rt`` runs in the RT loop thread and ``cycle`` in the non-RT loop thread, only
     while active. Plugin exceptions in cycles are contained: logged (at most once per second per
     plugin), reported as ``diagnostics.<alias>.error`` and handled per kind.
+
+    The node's own parameters are declared in ``NODE_PARAMETERS`` (read at configure into
+    ``node_values``). A parameter change (``ros2 param set``, a recovery mitigation's
+    reconfiguration) of a node parameter or of ``<alias>.<name>`` of a loaded plugin (or of one of
+    its sub-plugins, see ``ParameterOwner.parameter_owners``) is validated with its declaration:
+    a bad value is refused (``SetParametersResult(successful=False, reason=...)`` naming
+    parameter, value and rule); an accepted one is handed at once to ``plugin.apply_parameter``
+    (or :meth:`on_node_parameter_changed`). Parameter changes run in the thread of the parameter
+    service (or of the caller of ``set_parameters``).
     """
+
+    #: The node's own parameters (names relative to the node).
+    NODE_PARAMETERS: tuple[Param, ...] = ()
 
     KIND: PluginKind | None = None
     TYPES_PARAMETER = ""
@@ -56,6 +76,10 @@ class ComponentNode(LifecycleNode):
         self.system = system
         self.nav_state = system.nav_state
         self.params = NodeParameters(self)
+        self.node_values = ParameterValues()
+        self._validated: dict[str, Any] = {}
+        self.add_on_set_parameters_callback(self._validate_changes)
+        self.params.listeners.append(self._apply_change)
         self.plugins: list[LoadedPlugin] = []
         self.error_message = ""
         self.active = False
@@ -121,9 +145,100 @@ class ComponentNode(LifecycleNode):
         self.cleanup_node()
         return TransitionCallbackReturn.SUCCESS
 
+    # -- parameters -------------------------------------------------------------------------
+    def read_node_parameters(self) -> ParameterValues:
+        """Declare and read ``NODE_PARAMETERS`` into ``node_values``; a bad value raises
+        :class:`ConfigurationError` naming ``<node>.<parameter>``, the value and the rule."""
+        try:
+            self.node_values = read_parameters(
+                self.NODE_PARAMETERS, self.params, "",
+                warn=lambda message: self.get_logger().warning(message),
+            )
+        except ParameterValueError as exc:
+            raise ConfigurationError(f"{self.get_name()}.{exc}") from None
+        return self.node_values
+
+    def _owner_of(self, name: str) -> tuple[ParameterOwner, str] | None:
+        """The loaded plugin (or sub-plugin) that declares ``name``, and the name relative to it."""
+        best: tuple[ParameterOwner, str] | None = None
+        best_length = -1
+        for lp in self.plugins:
+            for prefix, owner in lp.plugin.parameter_owners():
+                if prefix and name.startswith(prefix + ".") and len(prefix) > best_length:
+                    best, best_length = (owner, name[len(prefix) + 1:]), len(prefix)
+        if best is None or best[0].parameter_declaration(best[1]) is None:
+            return None
+        return best
+
+    def check_parameter_change(self, name: str, value: Any, reconfiguring: bool = False) -> Any:
+        """``value`` for parameter ``name`` converted and checked against its declaration (a node
+        parameter or a loaded plugin's); raises :class:`ParameterValueError` with the reason.
+        Names nothing declares pass unchanged (``<alias>.plugin``, the types lists).
+        ``reconfiguring``: the change goes through a reconfiguration (the plugins are reloaded),
+        so parameters read only at configure may change too."""
+        for param in self.NODE_PARAMETERS:
+            if name == param.name or name in param.deprecated:
+                full = f"{self.get_name()}.{name}"
+                if not param.dynamic and self.active and not reconfiguring:
+                    raise ParameterValueError(
+                        f"{full}: cannot change while active (reconfigure instead)"
+                    )
+                converted = param.convert(value, full)
+                self.check_node_parameter(param.name, converted)
+                return converted
+        found = self._owner_of(name)
+        if found is None:
+            return value
+        owner, relative = found
+        param = owner.parameter_declaration(relative)
+        if reconfiguring and param is not None:
+            return param.convert(value, f"{owner.parameter_prefix}.{relative}")
+        return owner.validate_parameter(relative, value)
+
+    def check_node_parameter(self, name: str, value: Any) -> None:
+        """Rules of a node parameter that involve other values (override; raise
+        :class:`ParameterValueError`)."""
+
+    def _validate_changes(self, parameters: list[Any]) -> SetParametersResult:
+        changing = [p for p in parameters if self.params.is_changing(p.name)]
+        for parameter in changing:  # declarations (configure) are read and checked there
+            try:
+                self._validated[parameter.name] = self.check_parameter_change(
+                    parameter.name, parameter.value
+                )
+            except ParameterValueError as exc:
+                for p in changing:
+                    self.params.forget_pending(p.name)
+                    self._validated.pop(p.name, None)
+                return SetParametersResult(successful=False, reason=str(exc))
+        return SetParametersResult(successful=True)
+
+    def _apply_change(self, name: str, value: Any) -> None:
+        value = self._validated.pop(name, value)
+        for param in self.NODE_PARAMETERS:
+            if name == param.name:
+                if param.name in self.node_values:
+                    self.node_values.set(param.name, value)
+                self.on_node_parameter_changed(param.name, value)
+                return
+        found = self._owner_of(name)
+        if found is not None:
+            owner, relative = found
+            try:
+                owner.apply_parameter(relative, value)
+            except Exception as exc:  # the value is set; a plugin failing to take it is reported
+                self.get_logger().error(
+                    f"{name} = {value!r}: the plugin failed to apply it: "
+                    f"{type(exc).__name__}: {exc}"
+                )
+
+    def on_node_parameter_changed(self, name: str, value: Any) -> None:
+        """A node parameter changed at runtime (validated; ``node_values`` updated)."""
+
     # -- hooks for sub-classes ----------------------------------------------------------------
     def configure_node(self) -> None:
         """Declare and check the node's own parameters (before plugins load)."""
+        self.read_node_parameters()
 
     def after_plugins_loaded(self) -> None:
         """Anything that needs the plugins (after they load)."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
+from typing import Any
 
 from geometry_msgs.msg import Twist as TwistMsg
 from geometry_msgs.msg import TwistStamped as TwistStampedMsg
@@ -18,23 +19,32 @@ from rclpy.qos import (
 )
 
 from easynav.core.diagnostics import write_diagnostic
-from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER, SPEED_LIMIT
+from easynav.core.nav_state_keys import (
+    CMD_VEL,
+    MOTION_INHIBITED,
+    NAVIGATION_PAUSED,
+    PROPOSAL_OVERRIDE,
+    PROPOSAL_TAKEOVER,
+    SAFETY_STATUS,
+    SPEED_LIMIT,
+)
+from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
 from easynav.core.ros.converters import header_to_msg, twist_to_msg
 from easynav.core.system.component_node import ComponentNode, ConfigurationError
+from easynav.core.system.node_declarations import CONTROLLER_NODE_PARAMETERS
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
 from easynav.core.velocity import VelocityOutput
 
-# Former per-controller limit parameters and the robot_limits field each one stands for.
+# Former per-controller limit parameters (``<alias>.max_linear_speed``...), declared by the
+# controllers that had them, and the robot_limits field each one stands for.
 DEPRECATED_LIMIT_PARAMETERS = {
     "max_linear_speed": "max_linear_vel",
     "max_angular_speed": "max_angular_vel",
     "max_linear_acc": "max_linear_acc",
     "max_angular_acc": "max_angular_acc",
 }
-
-
 
 class ControllerNode(ComponentNode):
     """controller_node: runs the controller plugin and publishes the one velocity command.
@@ -48,6 +58,7 @@ class ControllerNode(ComponentNode):
     deactivates or shuts down, while the RT loop no longer cycles.
     """
 
+    NODE_PARAMETERS = CONTROLLER_NODE_PARAMETERS
     KIND = CONTROLLER
     TYPES_PARAMETER = "controller_types"
     MAX_PLUGINS = 1
@@ -67,29 +78,51 @@ class ControllerNode(ComponentNode):
 
     # -- configuration --------------------------------------------------------------------------
     def configure_node(self) -> None:
-        node = self.get_name()
-        values = {
-            name: float(self.params.declare(f"robot_limits.{name}", default))
-            for name, default in DEFAULT_ROBOT_LIMITS.items()
-        }
-        self.robot_limits = RobotLimits(**values)
-        self.cmd_timeout = float(self.params.declare("cmd_timeout", 0.5))
-        self.keepalive_period = float(self.params.declare("cmd_vel_keepalive_period", 0.0))
-        stamped = bool(self.params.declare("use_cmd_vel_stamped", False))
-        if self.forced_use_stamped is not None and "use_cmd_vel_stamped" not in (
-            self._parameter_overrides
-        ):
+        values = self.read_node_parameters()
+        self.robot_limits = RobotLimits(
+            **{name: values[f"robot_limits.{name}"] for name in DEFAULT_ROBOT_LIMITS}
+        )
+        self.cmd_timeout = values.cmd_timeout
+        self.keepalive_period = values.cmd_vel_keepalive_period
+        stamped = values.use_cmd_vel_stamped
+        if self.forced_use_stamped is not None and not self.params.is_set("use_cmd_vel_stamped"):
             stamped = self.forced_use_stamped
         self.use_stamped = stamped
-        errors = self.robot_limits.validation_errors(f"{node}.robot_limits.")
-        for name, value in (
-            ("cmd_timeout", self.cmd_timeout),
-            ("cmd_vel_keepalive_period", self.keepalive_period),
-        ):
-            if not (value >= 0.0 and value != float("inf")):
-                errors.append(f"{node}.{name} = {value} must be finite and >= 0")
+        self._check_limits()
+
+    def _check_limits(self) -> None:
+        errors = self.robot_limits.validation_errors(f"{self.get_name()}.robot_limits.")
         if errors:
             raise ConfigurationError("; ".join(errors))
+
+    def check_node_parameter(self, name: str, value: Any) -> None:
+        if name == "cmd_timeout":
+            for lp in self.plugins:
+                period = 1.0 / lp.plugin.rt_freq
+                if 0.0 < value <= period:
+                    raise ParameterValueError(
+                        f"{self.get_name()}.cmd_timeout = {value:g} s must be longer than the "
+                        f"controller's period ({lp.alias}.rt_freq = {lp.plugin.rt_freq:g} Hz)"
+                    )
+        if name.startswith("robot_limits."):
+            field = name.removeprefix("robot_limits.")
+            errors = replace(self.robot_limits, **{field: value}).validation_errors(
+                f"{self.get_name()}.robot_limits."
+            )
+            if errors:
+                raise ParameterValueError("; ".join(errors))
+
+    def on_node_parameter_changed(self, name: str, value: Any) -> None:
+        """A runtime change of ``robot_limits.*`` or ``cmd_timeout`` is in force from the next
+        RT cycle."""
+        if name.startswith("robot_limits."):
+            self.robot_limits = replace(
+                self.robot_limits, **{name.removeprefix("robot_limits."): float(value)}
+            )
+        elif name == "cmd_timeout":
+            self.cmd_timeout = float(value)
+            if self.velocity_output is not None:
+                self.velocity_output.set_cmd_timeout(self.cmd_timeout)
 
     def after_plugins_loaded(self) -> None:
         self._apply_deprecated_limits()
@@ -111,19 +144,34 @@ class ControllerNode(ComponentNode):
         self._create_publisher()
 
     def _apply_deprecated_limits(self) -> None:
-        overrides = self._parameter_overrides
+        """A controller's deprecated ``<alias>.max_linear_speed``... stands for a robot_limits
+        field only where the user did not set that field (params file, ``ros2 param set``, a
+        recovery mitigation): explicit robot_limits win. Applied, it is written into the
+        robot_limits parameter too, so what is read back (and restored after a mitigation) is
+        the limit in force."""
         for lp in self.plugins:
             for old, new in DEPRECATED_LIMIT_PARAMETERS.items():
                 old_name = f"{lp.alias}.{old}"
-                if old_name in overrides and f"robot_limits.{new}" not in overrides:
-                    value = float(overrides[old_name].value)
+                if not self.params.is_set(old_name) or old not in lp.plugin.params:
+                    continue
+                value = lp.plugin.params[old]
+                field_name = f"robot_limits.{new}"
+                if self.params.is_set(field_name):
                     self.get_logger().warning(
-                        f"{old_name} is deprecated: use robot_limits.{new} (applied: {value})"
+                        f"{old_name} is deprecated and ignored: {field_name} is set"
                     )
-                    self.robot_limits = replace(self.robot_limits, **{new: value})
-        errors = self.robot_limits.validation_errors(f"{self.get_name()}.robot_limits.")
-        if errors:
-            raise ConfigurationError("; ".join(errors))
+                    continue
+                self.get_logger().warning(
+                    f"{old_name} is deprecated: use {field_name} (applied: {value:g})"
+                )
+                self.robot_limits = replace(self.robot_limits, **{new: float(value)})
+                self._write_limit(field_name, float(value))
+        self._check_limits()
+
+    def _write_limit(self, name: str, value: float) -> None:
+        # Not a user's change: the deprecated value must still yield to a later explicit one.
+        self.params.set(name, value)
+        self.params.changed.discard(name)
 
     def _create_publisher(self) -> None:
         if self.cmd_publisher is not None:
@@ -154,8 +202,8 @@ class ControllerNode(ComponentNode):
     def limits_in_force(self) -> RobotLimits:
         """robot_limits, cut down by a safely limited speed when the safety channel says so."""
         limits = self.robot_limits
-        if self.nav_state.has("safety_status"):
-            state = self.nav_state.get("safety_status", SafetyChannelState)
+        if self.nav_state.has(SAFETY_STATUS):
+            state = self.nav_state.get(SAFETY_STATUS, SafetyChannelState)
             if state.valid and state.speed_limited:
                 limits = limits.cut_down(state.max_linear_vel, state.max_angular_vel)
         return limits
@@ -169,7 +217,7 @@ class ControllerNode(ComponentNode):
             if not ok:
                 # A failing controller stops the robot: a new zero command (braked smoothly).
                 now = self.now_seconds()
-                self.nav_state.set("cmd_vel", TwistStamped(Header(now, ""), Twist()))
+                self.nav_state.set(CMD_VEL, TwistStamped(Header(now, ""), Twist()))
 
     def publish_cycle(self) -> None:
         """Mux → smoother → guard → publish. RT thread, after the recovery system's RT cycle."""
@@ -178,12 +226,12 @@ class ControllerNode(ComponentNode):
             return
         nav_state = self.nav_state
         now = self.now_seconds()
-        controller_cmd = nav_state.get("cmd_vel") if nav_state.has("cmd_vel") else None
+        controller_cmd = nav_state.get(CMD_VEL) if nav_state.has(CMD_VEL) else None
         takeover = nav_state.get(PROPOSAL_TAKEOVER) if nav_state.has(PROPOSAL_TAKEOVER) else None
         override = nav_state.get(PROPOSAL_OVERRIDE) if nav_state.has(PROPOSAL_OVERRIDE) else None
-        paused = bool(nav_state.get_or("navigation_paused", False))
-        safety = nav_state.get("safety_status") if nav_state.has("safety_status") else None
-        inhibited = bool(nav_state.get_or("motion_inhibited", False))
+        paused = bool(nav_state.get_or(NAVIGATION_PAUSED, False))
+        safety = nav_state.get(SAFETY_STATUS) if nav_state.has(SAFETY_STATUS) else None
+        inhibited = bool(nav_state.get_or(MOTION_INHIBITED, False))
         # A speed zone (NavState speed_limit, a fraction) cuts the limits the output enforces,
         # not those controllers see: the zone is the velocity output's, as the safety cut is.
         zone = nav_state.get_or(SPEED_LIMIT, 1.0)

@@ -27,12 +27,43 @@ class NodeParameters(ParameterAccess):
     original expect YAML numbers to be numbers; any other type mismatch is a
     :class:`ParameterError` naming ``<node>.<parameter>``.
 
+    :meth:`is_set` is true for a parameter given in the params file (or ``-p``) and for one set
+    later (``ros2 param set``, a recovery mitigation's reconfiguration): rclpy calls
+    pre-set callbacks for ``set_parameters`` only, not for declarations, which is how a change is
+    told from a declaration.
+
     Thread contract: configuring thread (lifecycle transitions), or any thread for reads of
-    declared parameters.
+    declared parameters; the callbacks run in the thread that sets parameters.
     """
 
     def __init__(self, node: Any) -> None:
         self._node = node
+        self._pending: set[str] = set()
+        self.changed: set[str] = set()  # names set after their declaration, not defaults
+        #: Called with ``(name, value)`` after each successful change (not declarations).
+        self.listeners: list[Any] = []
+        node.add_pre_set_parameters_callback(self._before_set)
+        node.add_post_set_parameters_callback(self._after_set)
+
+    def _before_set(self, parameters: list[Parameter]) -> list[Parameter]:
+        self._pending.update(p.name for p in parameters)
+        return parameters
+
+    def _after_set(self, parameters: list[Parameter]) -> None:
+        for parameter in parameters:
+            if parameter.name in self._pending:
+                self._pending.discard(parameter.name)
+                self.changed.add(parameter.name)
+                for listener in self.listeners:
+                    listener(parameter.name, parameter.value)
+
+    def is_changing(self, name: str) -> bool:
+        """Whether ``name`` is being set right now (``set_parameters``), not declared."""
+        return name in self._pending
+
+    def forget_pending(self, name: str) -> None:
+        """A set of ``name`` was refused: it is not pending any more."""
+        self._pending.discard(name)
 
     def declare(self, name: str, default: Any, description: str = "") -> Any:
         node = self._node
@@ -89,7 +120,7 @@ class NodeParameters(ParameterAccess):
             raise ParameterError(f"{self._node.get_name()}.{name}: {result.reason}")
 
     def is_set(self, name: str) -> bool:
-        return name in self._node._parameter_overrides
+        return name in self._node._parameter_overrides or name in self.changed
 
     def get(self, name: str) -> Any:
         """The value of a declared parameter."""

@@ -15,8 +15,9 @@ class RuntimeReconfiguration:
     """Applies :class:`ReconfigureRequest` s posted by ``request_reconfigure`` /
     ``request_restore_parameters``.
 
-    - ``check(changes)``: refused when reconfiguration is not allowed (safety mode), or when a
-      node or parameter is unknown (neither declared on that node nor given in its params file).
+    - ``check(changes)``: refused when reconfiguration is not allowed (safety mode), when a
+      node or parameter is unknown (neither declared on that node nor given in its params file),
+      or when the value breaks the parameter's declaration (the reason names the rule).
     - Between non-RT cycles: deactivate (the robot brakes and stays stopped), clean up, set the
       parameters, configure, activate. The mission survives (the goal manager is kept). If the
       new configuration fails, the old values are restored and configured again.
@@ -43,12 +44,19 @@ class RuntimeReconfiguration:
         ok, why = self.allowed()
         if not ok:
             return False, why
-        for node_name, name, _value in changes:
+        for node_name, name, value in changes:
             target = self._target(node_name)
             if target is None:
                 return False, f"unknown node '{node_name}'"
             if not (target.has_parameter(name) or name in target._parameter_overrides):
                 return False, f"unknown parameter '{node_name}/{name}'"
+            # The same rules as any change (the node's or the loaded plugin's declaration).
+            checker = getattr(target, "check_parameter_change", None)
+            if checker is not None:
+                try:
+                    checker(name, value, reconfiguring=True)
+                except ValueError as exc:
+                    return False, str(exc)
         return True, ""
 
     def between_cycles(self) -> None:

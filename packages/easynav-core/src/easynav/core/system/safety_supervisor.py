@@ -18,6 +18,7 @@ from rclpy.qos import (
 from std_msgs.msg import String
 
 from easynav.core.diagnostics import write_diagnostic
+from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.ros.converters import time_to_msg
 from easynav.core.safety import (
     PARAMETER_TYPES,
@@ -32,20 +33,11 @@ from easynav.core.safety import (
     ros_log_dir,
 )
 from easynav.core.system.component_node import ConfigurationError
+from easynav.core.system.node_declarations import SAFETY_PARAMETERS
 from easynav.core.types import Odometry
 
-#: safety.* parameters of system_node and their defaults (seed-safety.txt).
-SAFETY_DEFAULTS: dict[str, Any] = {
-    "safety.mode": False,
-    "safety.lock_memory": False,
-    "safety.plc_limits.max_linear_vel": 0.0,  # 0: not given
-    "safety.plc_limits.max_angular_vel": 0.0,
-    "safety.heartbeat.period": 0.0,  # 0: off
-    "safety.rt_monitor.max_period_factor": 2.0,
-    "safety.rt_monitor.max_late_cycles": 10,
-    "safety.status.timeout": 0.0,  # 0: the safety channel's state is not read
-    "safety.max_pose_age": 1.0,  # 0: off
-}
+#: Defaults by name (read-only view for tools and tests).
+SAFETY_DEFAULTS: dict[str, Any] = {param.name: param.default for param in SAFETY_PARAMETERS}
 
 
 def _type_name(parameter: Parameter) -> str:
@@ -125,7 +117,11 @@ class SafetySupervisor:
     # -- configure ---------------------------------------------------------------------------------
     def configure(self) -> None:
         node = self.node
-        p = {name: node.params.declare(name, default) for name, default in SAFETY_DEFAULTS.items()}
+        try:
+            p = read_parameters(SAFETY_PARAMETERS, node.params, "")
+        except ParameterValueError as exc:
+            # Safety errors name their parameter as node/name (seed-safety.txt).
+            raise ConfigurationError(f"system_node/{exc}") from None
         self.mode = bool(p["safety.mode"])
         parameters = self.effective_parameters()
         errors = configuration_errors(

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import math
 import threading
+from dataclasses import replace
 from typing import Any
 
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
@@ -12,12 +12,14 @@ from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import String
 
 from easynav.core.plugins.compatibility import compatibility_errors
+from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.robot import RobotGeometry, RobotGeometryRegistry
 from easynav.core.system.component_node import ComponentNode
 from easynav.core.system.controller_node import ControllerNode
 from easynav.core.system.goal_manager_extension import GoalManagerExtension
 from easynav.core.system.localizer_node import LocalizerNode
 from easynav.core.system.maps_manager_node import MapsManagerNode
+from easynav.core.system.node_declarations import SYSTEM_PARAMETERS, SYSTEM_PARAMETERS_BY_NAME
 from easynav.core.system.node_parameters import NodeParameters
 from easynav.core.system.planner_node import PlannerNode
 from easynav.core.system.recovery_node import RecoveryNode
@@ -28,27 +30,8 @@ from easynav.core.system.system_context import SystemContext
 from easynav.core.system.system_requests import SystemRequests
 from easynav.core.tf import TFInfo, TFListener, get_tf_buffer
 
-#: Parameters of system_node and their defaults (REFERENCE.md §1).
-SYSTEM_DEFAULTS: dict[str, Any] = {
-    "use_real_time": True,
-    "rt_freq": 200.0,
-    "freq": 200.0,
-    "spin_time_rt": 0.001,
-    "spin_time_nort": 0.001,
-    "tf_prefix": "",
-    "map_frame": "map",
-    "odom_frame": "odom",
-    "robot_frame": "base_link",
-    "robot_footprint_frame": "base_footprint",
-    "world_frame": "earth",
-    "robot_geometry.radius": 0.3,
-    "robot_geometry.height": 0.5,
-    "allow_preempt_goal": True,
-    "position_tolerance": 0.03,
-    "height_tolerance": 1.7976931348623157e308,  # the largest finite double
-    "angle_tolerance": 0.01,
-    "update_frequency": 20.0,
-}
+#: Defaults by name (read-only view for tools and tests).
+SYSTEM_DEFAULTS: dict[str, Any] = {param.name: param.default for param in SYSTEM_PARAMETERS}
 
 # The order in which sub-nodes configure; cleanup runs in reverse.
 SUBNODE_ORDER = (
@@ -152,32 +135,19 @@ class SystemNode(LifecycleNode):
     # -- configuration --------------------------------------------------------------------------
     def read_parameters(self) -> None:
         """Declare and check system_node's own parameters; raises ValueError naming one."""
-        p = {name: self.params.declare(name, default) for name, default in SYSTEM_DEFAULTS.items()}
-        radius = float(p["robot_geometry.radius"])
-        p["robot_geometry.inscribed_radius"] = float(
-            self.params.declare("robot_geometry.inscribed_radius", radius)
-        )
-        errors = []
-        for name in ("rt_freq", "freq", "update_frequency"):
-            value = float(p[name])
-            if not math.isfinite(value) or value <= 0.0:
-                errors.append(f"system_node.{name} = {value} must be finite and > 0")
-        for name in (
-            "spin_time_rt",
-            "spin_time_nort",
-            "robot_geometry.radius",
-            "robot_geometry.inscribed_radius",
-            "robot_geometry.height",
-        ):
-            value = float(p[name])
-            if not math.isfinite(value) or value < 0.0:
-                errors.append(f"system_node.{name} = {value} must be finite and >= 0")
-        for name in ("position_tolerance", "angle_tolerance", "height_tolerance"):
-            value = float(p[name])
-            if not value >= 0.0:
-                errors.append(f"system_node.{name} = {value} must be >= 0")
-        if errors:
-            raise ValueError("; ".join(errors))
+        by_name = SYSTEM_PARAMETERS_BY_NAME
+        try:
+            # inscribed_radius defaults to the radius in force.
+            radius = read_parameters([by_name["robot_geometry.radius"]], self.params, "")
+            inscribed = replace(
+                by_name["robot_geometry.inscribed_radius"],
+                default=radius["robot_geometry.radius"],
+            )
+            declarations = [inscribed if p.name == inscribed.name else p for p in SYSTEM_PARAMETERS]
+            p = dict(read_parameters(declarations, self.params, ""))
+        except ParameterValueError as exc:
+            raise ValueError(f"system_node.{exc}") from None
+        radius = p["robot_geometry.radius"]
         self.parameters = p
         self.system.system_rt_freq = float(p["rt_freq"])
         self.system.system_freq = float(p["freq"])
@@ -204,6 +174,10 @@ class SystemNode(LifecycleNode):
                 radius=radius,
                 inscribed_radius=float(p["robot_geometry.inscribed_radius"]),
                 height=float(p["robot_geometry.height"]),
+                user_set=frozenset(
+                    name for name in ("radius", "inscribed_radius", "height")
+                    if self.params.is_set(f"robot_geometry.{name}")
+                ),
             ),
             self._ns_key(),
         )

@@ -99,6 +99,14 @@ class VelocityOutput:
         """The command timeout in seconds (0: off)."""
         return self._guard.cmd_timeout
 
+    def set_cmd_timeout(self, cmd_timeout: float) -> None:
+        """A new command timeout (a runtime parameter change), used from the next cycle.
+
+        Raises ``ValueError`` for a negative or non-finite value."""
+        if not (math.isfinite(cmd_timeout) and cmd_timeout >= 0.0):
+            raise ValueError(f"cmd_timeout = {cmd_timeout} must be finite and >= 0 (0: off)")
+        self._guard.cmd_timeout = float(cmd_timeout)
+
     # -- RT cycle ----------------------------------------------------------------------------
     def cycle(
         self,

@@ -83,6 +83,12 @@ class CostmapMapsManager(MapsManagerBase):
     WRITES = (MAP_BASE, MAP, MAP_TIME, MAP_OBSTACLE_BOUNDS)
     PROVIDES_MAPS = ("costmap",)
 
+    SUB_PLUGIN_LISTS = {"filters": COSTMAP_FILTER}
+
+    def sub_plugins(self) -> list:
+        """The loaded filters (runtime parameter changes of ``<alias>.<filter>.*`` go to them)."""
+        return [instance for _, instance in self._filters]
+
     def __init__(self) -> None:
         super().__init__()
         self._base: Costmap2D | None = None

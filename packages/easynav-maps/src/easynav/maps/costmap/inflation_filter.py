@@ -9,7 +9,6 @@ import numpy as np
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
-from easynav.core.robot import RobotGeometry
 from easynav.core.types import Costmap2D
 from easynav.maps.costmap.costmap_filter import CostmapFilter
 from easynav.maps.costmap.keys import MAP_BASE, MAP_OBSTACLE_BOUNDS
@@ -47,7 +46,8 @@ class InflationFilter(CostmapFilter):
 
     The inscribed radius is ``system_node.robot_geometry.inscribed_radius``. The filter's own
     ``inscribed_radius`` (the original's, 0.25) is deprecated: set, it applies (with a warning)
-    only while robot_geometry keeps its default; robot_geometry takes precedence otherwise.
+    only where the params file sets neither ``robot_geometry.inscribed_radius`` nor the
+    ``robot_geometry.radius`` it defaults to; robot_geometry takes precedence otherwise.
 
     ``map.base`` is inflated once and cached (again when its size, resolution, origin or stamp,
     or a parameter, change); each cycle the working map is inflated only inside
@@ -98,7 +98,9 @@ class InflationFilter(CostmapFilter):
         if math.isnan(legacy):
             return geometry.inscribed_radius
         name = f"{self.plugin_name}.inscribed_radius"
-        if geometry.inscribed_radius != RobotGeometry().inscribed_radius:
+        # robot_geometry configures the inscribed radius when the params file sets it, or sets
+        # the radius it defaults to (seed-design: it takes precedence, whatever its value).
+        if geometry.is_set("inscribed_radius") or geometry.is_set("radius"):
             message = (
                 f"{name} is deprecated and ignored: system_node.robot_geometry.inscribed_radius "
                 f"= {geometry.inscribed_radius:g} takes precedence"

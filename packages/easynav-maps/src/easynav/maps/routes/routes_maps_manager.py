@@ -59,6 +59,12 @@ class RoutesMapsManager(MapsManagerBase):
     # before it in map_types: alone it has nothing to steer.
     NEEDS_MAPS = ("costmap",)
 
+    SUB_PLUGIN_LISTS = {"filters": ROUTES_FILTER}
+
+    def sub_plugins(self) -> list:
+        """The loaded filters (runtime parameter changes of ``<alias>.<filter>.*`` go to them)."""
+        return [instance for _, instance in self._filters]
+
     def __init__(self) -> None:
         super().__init__()
         self._routes = RoutesMap.default()

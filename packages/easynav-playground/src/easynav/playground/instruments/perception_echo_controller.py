@@ -8,7 +8,8 @@ for driving a robot.
 from __future__ import annotations
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import ControllerMethodBase
+from easynav.core.nav_state_keys import CMD_VEL
+from easynav.core.plugins import ControllerMethodBase, Param
 from easynav.core.sensors import PointPerception
 from easynav.core.types import Header, Twist, TwistStamped
 
@@ -17,13 +18,15 @@ class PerceptionEchoController(ControllerMethodBase):
     """Writes ``cmd_vel`` with ``vx = scale · (number of points of the newest perception)``.
 
     The benchmark varies the number of valid ranges in each scan it sends, so each scan maps to a
-    distinct command value. Parameters: ``scale`` (m/s per point, 1e-4).
+    distinct command value. Parameters: :attr:`PARAMETERS`.
 
     Thread contract: RT thread (``update_rt``).
     """
 
+    PARAMETERS = (Param("scale", 1e-4, "command per point of the newest perception", "m/s"),)
+    WRITES = (CMD_VEL,)
+
     def on_initialize(self) -> None:
-        self.scale = float(self.get_parameter("scale", 1e-4))
         self._last_stamp = None
 
     def update_rt(self, nav_state: NavState) -> None:
@@ -32,5 +35,5 @@ class PerceptionEchoController(ControllerMethodBase):
         if newest is None or newest.stamp == self._last_stamp:
             return
         self._last_stamp = newest.stamp
-        twist = Twist(vx=self.scale * len(newest.points))
-        nav_state.set("cmd_vel", TwistStamped(Header(self.now(), ""), twist))
+        twist = Twist(vx=self.params.scale * len(newest.points))
+        nav_state.set(CMD_VEL, TwistStamped(Header(self.now(), ""), twist))

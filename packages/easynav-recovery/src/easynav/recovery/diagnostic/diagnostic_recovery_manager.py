@@ -11,6 +11,7 @@ from easynav.core.diagnostics import read_diagnostics, write_diagnostic
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import (
     MethodBase,
+    Param,
     PluginConfigurationError,
     RateMonitor,
     RecoveryManagerBase,
@@ -28,7 +29,6 @@ from easynav.recovery.diagnostic.plugin_kinds import EVALUATOR, MITIGATION, SAFE
 from easynav.recovery.diagnostic.recovery_topics import RecoveryTopics
 from easynav.recovery.diagnostic.safety_reflex_base import SafetyReflexBase
 from easynav.recovery.navigation_context import commanded_velocity
-from easynav.recovery.parameters import read_int, read_str_list
 from easynav.recovery.takeover_slot import TakeoverSlot
 
 DEFAULT_PRIORITY = 100
@@ -58,6 +58,32 @@ class DiagnosticRecoveryManager(RecoveryManagerBase):
     ones) or ``PluginLoadError``; plugin exceptions in cycles are contained.
     """
 
+    PARAMETERS = (
+        Param("safety_reflex_types", [], "aliases of the safety reflexes (level 0, RT)",
+              type="str[]", dynamic=False),
+        Param("evaluator_types", [], "aliases of the evaluators (level 1)", type="str[]",
+              dynamic=False),
+        Param("mitigation_types", [], "aliases of the mitigations (level 1)", type="str[]",
+              dynamic=False),
+    )
+    #: Sub-plugin lists and the plugin kind of their aliases.
+    SUB_PLUGIN_LISTS = {
+        "safety_reflex_types": SAFETY_REFLEX,
+        "evaluator_types": EVALUATOR,
+        "mitigation_types": MITIGATION,
+    }
+    READS = (keys.CMD_VEL, keys.PROPOSAL_TAKEOVER, keys.PROPOSAL_OVERRIDE)
+    WRITES = (keys.CONTROL_OWNER, keys.PROPOSAL_TAKEOVER, keys.PROPOSAL_OVERRIDE)
+
+    def sub_plugins(self) -> list[MethodBase]:
+        """Every loaded reflex, evaluator and mitigation (runtime parameter changes of
+        ``recovery_manager.<alias>.*`` go to them)."""
+        loaded = [
+            *getattr(self, "reflexes", []), *getattr(self, "evaluators", []),
+            *getattr(self, "mitigations", []),
+        ]
+        return [plugin for _, plugin in loaded]
+
     def on_initialize(self) -> None:
         self.schedule = ActivationAwareSchedule(self.freq, self._on_activation)
         self._slot = TakeoverSlot.for_cycle(self.context.system_freq)
@@ -70,20 +96,18 @@ class DiagnosticRecoveryManager(RecoveryManagerBase):
         self.reflexes: list[tuple[str, SafetyReflexBase]] = []
         self.evaluators: list[tuple[str, EvaluatorBase]] = []
         mitigations: list[tuple[str, MitigationBase]] = []
+        self.mitigations: list[tuple[str, MitigationBase]] = []
         self._topics: RecoveryTopics | None = None
         try:
             lists = {
-                name: read_str_list(self, name, [])
+                name: list(self.params[name])
                 for name in ("safety_reflex_types", "evaluator_types", "mitigation_types")
             }
             self._check_aliases(lists)
             self.reflexes = self._load(SAFETY_REFLEX, lists["safety_reflex_types"])
             self.evaluators = self._load(EVALUATOR, lists["evaluator_types"])
             loaded = self._load(MITIGATION, lists["mitigation_types"])
-            priorities = {
-                alias: read_int(self, f"{alias}.priority", DEFAULT_PRIORITY, minimum=None)
-                for alias, _ in loaded
-            }
+            priorities = {alias: mitigation.params.priority for alias, mitigation in loaded}
             # Lower first; sorted() is stable, so ties keep the mitigation_types order.
             mitigations = sorted(loaded, key=lambda item: priorities[item[0]])
             for alias, mitigation in mitigations:

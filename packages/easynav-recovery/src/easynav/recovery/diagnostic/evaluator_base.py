@@ -27,6 +27,13 @@ class EvaluatorBase(MethodBase):
     #: Evaluators run in the non-RT cycle at ``freq`` (the manager schedules them).
     HAS_UPDATE = True
 
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """Plugins of this family keep each parameter in a same-named attribute (set in
+        ``on_initialize``): a runtime change updates it (derived state is built from parameters
+        declared ``dynamic=False``)."""
+        if name in vars(self):
+            setattr(self, name, value)
+
     @property
     def diagnostic_name(self) -> str:
         """Name under ``diagnostics.`` (the plugin name, e.g. ``recovery_manager.no_path``)."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import MethodBase, RecoveryActions
+from easynav.core.plugins import MethodBase, Param, RecoveryActions
 from easynav.core.types import DiagnosticStatus, Twist
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.recovery_status import RecoveryStatus
@@ -36,6 +36,18 @@ class MitigationBase(MethodBase):
     """
 
     REQUIRES_CONTROL = False
+    #: Every mitigation's rank (read by the manager): lower first, ties keep the list order.
+    BASE_PARAMETERS = (
+        *MethodBase.BASE_PARAMETERS,
+        Param("priority", 100, "rank among the mitigations: lower first", dynamic=False),
+    )
+
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """Plugins of this family keep each parameter in a same-named attribute (set in
+        ``on_initialize``): a runtime change updates it (derived state is built from parameters
+        declared ``dynamic=False``)."""
+        if name in vars(self):
+            setattr(self, name, value)
 
     def __init__(self) -> None:
         super().__init__()

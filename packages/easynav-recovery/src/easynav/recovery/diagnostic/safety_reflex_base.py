@@ -35,6 +35,13 @@ class SafetyReflexBase(MethodBase):
         self._reported: tuple[DiagnosticLevel, str] | None = None
         self._last_error_log = -1e9
 
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """Plugins of this family keep each parameter in a same-named attribute (set in
+        ``on_initialize``): a runtime change updates it (derived state is built from parameters
+        declared ``dynamic=False``)."""
+        if name in vars(self):
+            setattr(self, name, value)
+
     @property
     def actions(self) -> RecoveryActions:
         """The recovery node's system actions."""

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import RecoveryManagerBase
+from easynav.core.plugins import Param, RecoveryManagerBase
 from easynav.core.robot import RobotGeometry
 from easynav.core.sensors import PointPerception
 from easynav.core.tf import get_tf_buffer
@@ -23,7 +23,6 @@ from easynav.recovery.navigation_context import (
     navigation_paused,
     protective_stop,
 )
-from easynav.recovery.parameters import read_float, read_int
 from easynav.recovery.simple.simple_mitigation import SimpleMitigation
 from easynav.recovery.takeover_slot import TakeoverSlot
 
@@ -61,35 +60,51 @@ class SimpleRecoveryManager(RecoveryManagerBase):
        (``controller_node.robot_limits.max_linear_vel = slow_down_max_linear_vel``; 0: never);
        still stuck → ``abort_mission``.
 
-    The deprecated ``robot_radius`` and ``max_obstacle_z`` stand in for
-    ``system_node.robot_geometry.radius``/``height`` (with a warning) when the geometry is left at
-    its defaults.
+    Parameters: :attr:`PARAMETERS`. The deprecated ``robot_radius`` and ``max_obstacle_z`` stand
+    in for ``system_node.robot_geometry.radius``/``height`` (with a warning) where the params
+    file does not set that robot_geometry field.
 
     Thread contract: ``update_rt`` in the RT thread, ``update`` in the non-RT thread; they share
     only a :class:`TakeoverSlot` (locked) and immutable parameters. Exceptions: ``initialize``
     raises ``PluginConfigurationError`` naming a bad parameter; the host contains the rest.
     """
 
+    PARAMETERS = (
+        Param("stop_distance", 0.3, "brake for points this far beyond the radius ahead", "m",
+              ge=0.0),
+        Param("min_obstacle_z", 0.05, "points at or below this height are ground", "m"),
+        Param("robot_radius", math.nan, "deprecated: system_node robot_geometry.radius", "m",
+              ge=0.0, allow_nan=True, dynamic=False),
+        Param("max_obstacle_z", math.nan, "deprecated: system_node robot_geometry.height", "m",
+              ge=0.0, allow_nan=True, dynamic=False),
+        Param("sensors_timeout", 5.0, "no point data for this long: request_shutdown", "s",
+              gt=0.0),
+        Param("max_position_variance", 1.0, "x or y variance above this: relocalise", "m²",
+              gt=0.0),
+        Param("relocalize_timeout", 20.0, "abort the mission after relocalising this long", "s",
+              gt=0.0),
+        Param("rotate_speed", 0.5, "turn rate while relocalising", "rad/s"),
+        Param("stuck_time", 10.0, "stuck: commanded but moved less than stuck_distance in this",
+              "s", gt=0.0),
+        Param("stuck_distance", 0.05, "stuck: moved less than this in stuck_time", "m", gt=0.0),
+        Param("backup_speed", 0.1, "speed of a backup (driven backwards)", "m/s", ge=0.0),
+        Param("backup_time", 2.0, "duration of a backup", "s", ge=0.0),
+        Param("max_backup_attempts", 3, "backups before slowing down", ge=0),
+        Param("slow_down_max_linear_vel", 0.1,
+              "robot_limits.max_linear_vel after the backups (0: never slow down)", "m/s",
+              ge=0.0),
+    )
+    READS = (
+        keys.ROBOT_POSE, keys.CMD_VEL, keys.GOALS, keys.NAVIGATION_STATE, keys.NAVIGATION_PAUSED,
+        keys.SAFETY_STATUS, keys.SENSORS_DIAGNOSTIC, keys.RECONFIGURED_PARAMETERS,
+    )
+    WRITES = (keys.PROPOSAL_OVERRIDE, keys.PROPOSAL_TAKEOVER)
+
     def on_initialize(self) -> None:
-        self.stop_distance = read_float(self, "stop_distance", 0.3)
-        self.min_obstacle_z = read_float(self, "min_obstacle_z", 0.05, minimum=None)
+        self._read_tuning()
         geometry = self.get_robot_geometry()
-        self.robot_radius = self._geometry_or_deprecated(
-            "robot_radius", geometry.radius, RobotGeometry().radius, "radius"
-        )
-        self.max_obstacle_z = self._geometry_or_deprecated(
-            "max_obstacle_z", geometry.height, RobotGeometry().height, "height"
-        )
-        self.sensors_timeout = read_float(self, "sensors_timeout", 5.0, positive=True)
-        self.max_position_variance = read_float(self, "max_position_variance", 1.0, positive=True)
-        self.relocalize_timeout = read_float(self, "relocalize_timeout", 20.0, positive=True)
-        self.rotate_speed = read_float(self, "rotate_speed", 0.5, minimum=None)
-        self.stuck_time = read_float(self, "stuck_time", 10.0, positive=True)
-        self.stuck_distance = read_float(self, "stuck_distance", 0.05, positive=True)
-        self.backup_speed = read_float(self, "backup_speed", 0.1)
-        self.backup_time = read_float(self, "backup_time", 2.0)
-        self.max_backup_attempts = read_int(self, "max_backup_attempts", 3)
-        self.slow_down_max_linear_vel = read_float(self, "slow_down_max_linear_vel", 0.1)
+        self.robot_radius = self._geometry_or_deprecated("robot_radius", geometry, "radius")
+        self.max_obstacle_z = self._geometry_or_deprecated("max_obstacle_z", geometry, "height")
 
         self.schedule = ActivationAwareSchedule(self.freq, self._on_activation)
         self._slot = TakeoverSlot.for_cycle(self.context.system_freq)
@@ -113,15 +128,34 @@ class SimpleRecoveryManager(RecoveryManagerBase):
         self._restore_requested = False
         self._abort_requested = False
 
-    def _geometry_or_deprecated(
-        self, name: str, geometry_value: float, geometry_default: float, field: str
-    ) -> float:
-        # NaN means "not set": the deprecated parameter only counts when a user sets it.
-        legacy = read_float(self, name, math.nan, allow_nan=True, description="deprecated")
+    def _read_tuning(self) -> None:
+        # Plain attributes for the readable algorithm below; refreshed on a runtime change.
+        p = self.params
+        self.stop_distance = p.stop_distance
+        self.min_obstacle_z = p.min_obstacle_z
+        self.sensors_timeout = p.sensors_timeout
+        self.max_position_variance = p.max_position_variance
+        self.relocalize_timeout = p.relocalize_timeout
+        self.rotate_speed = p.rotate_speed
+        self.stuck_time = p.stuck_time
+        self.stuck_distance = p.stuck_distance
+        self.backup_speed = p.backup_speed
+        self.backup_time = p.backup_time
+        self.max_backup_attempts = p.max_backup_attempts
+        self.slow_down_max_linear_vel = p.slow_down_max_linear_vel
+
+    def on_parameter_changed(self, name: str, value: object) -> None:
+        """Tuning applies from the next cycle (``min_obstacle_z`` at the next configure)."""
+        self._read_tuning()
+
+    def _geometry_or_deprecated(self, name: str, geometry: RobotGeometry, field: str) -> float:
+        geometry_value = getattr(geometry, field)
+        legacy = self.params[name]  # NaN: not set
         if math.isnan(legacy):
             return geometry_value
         full = f"{self.plugin_name}.{name}"
-        if geometry_value != geometry_default:
+        if geometry.is_set(field):
+            # seed-design: robot_geometry takes precedence when both are set.
             self.logger.warning(
                 f"{full} is deprecated and ignored: system_node.robot_geometry.{field} = "
                 f"{geometry_value:g} takes precedence"

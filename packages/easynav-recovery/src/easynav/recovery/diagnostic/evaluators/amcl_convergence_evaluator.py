@@ -7,10 +7,10 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.evaluator_base import EvaluatorBase
-from easynav.recovery.parameters import read_float
 
 
 class AmclConvergenceEvaluator(EvaluatorBase):
@@ -24,8 +24,13 @@ class AmclConvergenceEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "localizer.amcl"
 
+    READS = (keys.AMCL_COVARIANCE_TRACE,)
+    PARAMETERS = (
+        Param("covariance_threshold", 1.0, "a covariance trace above this is an ERROR", "", gt=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.covariance_threshold = read_float(self, "covariance_threshold", 1.0, positive=True)
+        self.covariance_threshold = self.params.covariance_threshold
 
     def update(self, nav_state: NavState) -> None:
         if not nav_state.has(keys.AMCL_COVARIANCE_TRACE):

@@ -8,6 +8,7 @@ import math
 
 from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.tf import TransformError, get_tf_buffer
 from easynav.core.types import DiagnosticLevel, Odometry, TwistStamped
 from easynav.recovery import nav_state_keys as keys
@@ -18,7 +19,6 @@ from easynav.recovery.navigation_context import (
     navigation_paused,
     protective_stop,
 )
-from easynav.recovery.parameters import read_float
 
 
 class ControllerStuckEvaluator(EvaluatorBase):
@@ -45,12 +45,22 @@ class ControllerStuckEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "controller_stuck"
 
+    READS = (
+        keys.GOALS, keys.NAVIGATION_STATE, keys.CMD_VEL, keys.ROBOT_POSE, keys.NAVIGATION_PAUSED,
+        keys.SAFETY_STATUS, keys.CONTROL_OWNER,
+    )
+    PARAMETERS = (
+        Param("linear_velocity_threshold", 0.02,
+              "a command at least this fast counts as an attempt to move", "m/s", ge=0.0),
+        Param("progress_distance_threshold", 0.05,
+              "moving at most this far in the window is being stuck", "m", gt=0.0),
+        Param("stuck_time_threshold", 2.0, "the window", "s", gt=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.linear_velocity_threshold = read_float(self, "linear_velocity_threshold", 0.02)
-        self.progress_distance_threshold = read_float(
-            self, "progress_distance_threshold", 0.05, positive=True
-        )
-        self.stuck_time_threshold = read_float(self, "stuck_time_threshold", 2.0, positive=True)
+        self.linear_velocity_threshold = self.params.linear_velocity_threshold
+        self.progress_distance_threshold = self.params.progress_distance_threshold
+        self.stuck_time_threshold = self.params.stuck_time_threshold
         # (source, x, y): source "odom" (odometry from TF) or "robot_pose" (the fallback).
         self._reference: tuple[str, float, float] | None = None
         self._reference_time = 0.0

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, Path
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.evaluator_base import EvaluatorBase
 from easynav.recovery.navigation_context import has_active_goal
-from easynav.recovery.parameters import read_float
 
 
 class NoPathEvaluator(EvaluatorBase):
@@ -21,8 +21,14 @@ class NoPathEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "planner"
 
+    READS = (keys.GOALS, keys.NAVIGATION_STATE, keys.PATH)
+    PARAMETERS = (
+        Param("debounce_duration", 1.0,
+              "WARN becomes ERROR after this long without a path (0: at once)", "s", ge=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.debounce_duration = read_float(self, "debounce_duration", 1.0)
+        self.debounce_duration = self.params.debounce_duration
         self._since: float | None = None
 
     def update(self, nav_state: NavState) -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticLevel, Odometry
 from easynav.recovery import nav_state_keys as keys
@@ -18,7 +19,6 @@ from easynav.recovery.navigation_context import (
     protective_stop,
 )
 from easynav.recovery.obstacle_proximity import nearest_obstacle
-from easynav.recovery.parameters import read_float
 
 
 class ObstacleTooCloseEvaluator(EvaluatorBase):
@@ -38,16 +38,28 @@ class ObstacleTooCloseEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "obstacle_proximity"
 
+    READS = (
+        keys.ROBOT_POSE, keys.GOALS, keys.NAVIGATION_STATE, keys.NAVIGATION_PAUSED,
+        keys.SAFETY_STATUS,
+    )
+    PARAMETERS = (
+        Param("safe_distance", 0.6, "a point closer than this to the robot centre is too close",
+              "m", gt=0.0),
+        Param("z_min_filter", 0.0, "points below this height are ignored", "m", dynamic=False),
+        Param("debounce_duration", 0.2, "stopped this long with a point too close: ERROR",
+              "s", ge=0.0),
+        Param("linear_velocity_epsilon", 0.02, "below this speed the robot is stopped",
+              "m/s", gt=0.0),
+        Param("angular_velocity_epsilon", 0.05, "below this turn rate the robot is stopped",
+              "rad/s", gt=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.safe_distance = read_float(self, "safe_distance", 0.6, positive=True)
-        self.z_min_filter = read_float(self, "z_min_filter", 0.0, minimum=None)
-        self.debounce_duration = read_float(self, "debounce_duration", 0.2)
-        self.linear_velocity_epsilon = read_float(
-            self, "linear_velocity_epsilon", 0.02, positive=True
-        )
-        self.angular_velocity_epsilon = read_float(
-            self, "angular_velocity_epsilon", 0.05, positive=True
-        )
+        self.safe_distance = self.params.safe_distance
+        self.z_min_filter = self.params.z_min_filter
+        self.debounce_duration = self.params.debounce_duration
+        self.linear_velocity_epsilon = self.params.linear_velocity_epsilon
+        self.angular_velocity_epsilon = self.params.angular_velocity_epsilon
         self._cloud = FusedPointCloud(
             self.context.namespace,
             z_min=self.z_min_filter,

@@ -7,10 +7,10 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, SafetyChannelState
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.evaluator_base import EvaluatorBase
-from easynav.recovery.parameters import read_float
 
 
 class SafetyChannelEvaluator(EvaluatorBase):
@@ -25,8 +25,14 @@ class SafetyChannelEvaluator(EvaluatorBase):
 
     HARDWARE_ID = "safety_channel"
 
+    READS = (keys.SAFETY_STATUS,)
+    PARAMETERS = (
+        Param("max_stop_time", 0.0, "a protective stop this long is an ERROR (0: never)",
+              "s", ge=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.max_stop_time = read_float(self, "max_stop_time", 0.0)
+        self.max_stop_time = self.params.max_stop_time
         self._stop_start: float | None = None
 
     def update(self, nav_state: NavState) -> None:

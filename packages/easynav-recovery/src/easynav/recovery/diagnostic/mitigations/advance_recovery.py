@@ -7,12 +7,12 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Odometry, Twist
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
 from easynav.recovery.diagnostic.recovery_status import RecoveryStatus
-from easynav.recovery.parameters import read_float
 
 
 class AdvanceRecovery(MitigationBase):
@@ -30,11 +30,21 @@ class AdvanceRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    READS = (keys.ROBOT_POSE,)
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
+    PARAMETERS = (
+        Param("advance_distance", 0.3, "distance driven forward per attempt", "m", gt=0.0),
+        Param("advance_speed", 0.1, "forward speed", "m/s", gt=0.0),
+        Param("escalate_after", 15.0, "a stuck episode this long: FAILED", "s", gt=0.0),
+        Param("episode_gap", 10.0, "a start this long after the last attempt begins a new episode",
+              "s", ge=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.advance_distance = read_float(self, "advance_distance", 0.3, positive=True)
-        self.advance_speed = read_float(self, "advance_speed", 0.1, positive=True)
-        self.escalate_after = read_float(self, "escalate_after", 15.0, positive=True)
-        self.episode_gap = read_float(self, "episode_gap", 10.0)
+        self.advance_distance = self.params.advance_distance
+        self.advance_speed = self.params.advance_speed
+        self.escalate_after = self.params.escalate_after
+        self.episode_gap = self.params.episode_gap
         self._episode_start: float | None = None
         self._last_stop: float | None = None
         self._start_position: tuple[float, float] | None = None

@@ -7,12 +7,12 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Twist
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
 from easynav.recovery.diagnostic.recovery_status import RecoveryStatus
-from easynav.recovery.parameters import read_float
 
 
 class AmclRelocalizeMitigation(MitigationBase):
@@ -26,10 +26,19 @@ class AmclRelocalizeMitigation(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    READS = (keys.AMCL_COVARIANCE_TRACE,)
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
+    PARAMETERS = (
+        Param("rotation_speed", 0.3, "turn rate while relocalising", "rad/s"),
+        Param("timeout", 5.0, "FAILED after this long", "s", gt=0.0),
+        Param("covariance_threshold", 1.0, "SUCCEEDED at or below this covariance trace",
+              "", gt=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.rotation_speed = read_float(self, "rotation_speed", 0.3, minimum=None)
-        self.timeout = read_float(self, "timeout", 5.0, positive=True)
-        self.covariance_threshold = read_float(self, "covariance_threshold", 1.0, positive=True)
+        self.rotation_speed = self.params.rotation_speed
+        self.timeout = self.params.timeout
+        self.covariance_threshold = self.params.covariance_threshold
         self._start = 0.0
 
     def can_handle(self, status: DiagnosticStatus) -> bool:

@@ -6,12 +6,13 @@ from __future__ import annotations
 
 from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_arbiter import is_rate_diagnostic
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
 from easynav.recovery.diagnostic.recovery_status import RecoveryStatus
-from easynav.recovery.parameters import read_float, read_str_list
 
 #: How often (s) it repeats that it is still waiting.
 WAIT_REPORT_PERIOD = 5.0
@@ -28,9 +29,16 @@ class HumanAssistanceRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
+    PARAMETERS = (
+        Param("timeout", 0.0, "FAILED after waiting this long (0: waits forever)", "s", ge=0.0),
+        Param("ignored_hardware_ids", ["ros_graph"],
+              "hardware ids of the ERRORs it does not handle", "", type="str[]"),
+    )
+
     def on_initialize(self) -> None:
-        self.timeout = read_float(self, "timeout", 0.0)
-        self.ignored_hardware_ids = read_str_list(self, "ignored_hardware_ids", ["ros_graph"])
+        self.timeout = self.params.timeout
+        self.ignored_hardware_ids = self.params.ignored_hardware_ids
         self._start = 0.0
         self._last_wait_report = 0.0
 

@@ -7,14 +7,15 @@ from __future__ import annotations
 import math
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Twist
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
 from easynav.recovery.diagnostic.recovery_status import RecoveryStatus
 from easynav.recovery.fused_point_cloud import FusedPointCloud
 from easynav.recovery.obstacle_proximity import free_distance_along_x, nearest_obstacle
-from easynav.recovery.parameters import read_float
 
 
 class SafeRetreatRecovery(MitigationBase):
@@ -41,12 +42,22 @@ class SafeRetreatRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
+    PARAMETERS = (
+        Param("safe_distance", 0.6, "SUCCEEDED this far from the nearest obstacle (robot centre)",
+              "m", gt=0.0),
+        Param("retreat_speed", 0.15, "retreat speed", "m/s", gt=0.0),
+        Param("z_min_filter", 0.0, "points below this height are ignored", "m", dynamic=False),
+        Param("min_clearance", 0.05, "a way with less free space is blocked", "m", ge=0.0),
+        Param("timeout", 10.0, "FAILED after this long (0: none)", "s", ge=0.0),
+    )
+
     def on_initialize(self) -> None:
-        self.safe_distance = read_float(self, "safe_distance", 0.6, positive=True)
-        self.retreat_speed = read_float(self, "retreat_speed", 0.15, positive=True)
-        self.z_min_filter = read_float(self, "z_min_filter", 0.0, minimum=None)
-        self.min_clearance = read_float(self, "min_clearance", 0.05)
-        self.timeout = read_float(self, "timeout", 10.0)
+        self.safe_distance = self.params.safe_distance
+        self.retreat_speed = self.params.retreat_speed
+        self.z_min_filter = self.params.z_min_filter
+        self.min_clearance = self.params.min_clearance
+        self.timeout = self.params.timeout
         geometry = self.get_robot_geometry()
         self.robot_radius = geometry.radius
         self._cloud = FusedPointCloud(

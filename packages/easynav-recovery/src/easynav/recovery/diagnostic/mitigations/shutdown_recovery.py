@@ -6,13 +6,14 @@ from __future__ import annotations
 
 from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels
 from easynav.recovery.diagnostic.mitigation_arbiter import is_rate_diagnostic
 from easynav.recovery.diagnostic.mitigation_base import MitigationBase
 from easynav.recovery.diagnostic.recovery_status import RecoveryStatus
 from easynav.recovery.navigation_context import has_active_goal
-from easynav.recovery.parameters import read_str_list
 
 
 class ShutdownRecovery(MitigationBase):
@@ -26,8 +27,14 @@ class ShutdownRecovery(MitigationBase):
 
     REQUIRES_CONTROL = True
 
+    WRITES = (keys.PROPOSAL_TAKEOVER,)
+    PARAMETERS = (
+        Param("handled_hardware_ids", ["ros_graph"],
+              "hardware ids of the ERRORs that shut EasyNav down", "", type="str[]"),
+    )
+
     def on_initialize(self) -> None:
-        self.handled_hardware_ids = read_str_list(self, "handled_hardware_ids", ["ros_graph"])
+        self.handled_hardware_ids = self.params.handled_hardware_ids
 
     def can_handle(self, status: DiagnosticStatus) -> bool:
         return (

@@ -9,11 +9,12 @@ import math
 import numpy as np
 
 from easynav.core.nav_state import NavState
+from easynav.core.plugins import Param
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Twist
+from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.safety_reflex_base import SafetyReflexBase
 from easynav.recovery.fused_point_cloud import FusedPointCloud
-from easynav.recovery.parameters import read_float
 
 #: Below this linear speed (m/s) the robot is not moving (rotating in place is allowed blind).
 MOVING_SPEED = 1e-3
@@ -45,11 +46,21 @@ class CollisionSafetyReflex(SafetyReflexBase):
     Thread contract: as :class:`SafetyReflexBase` (``check`` in the RT thread).
     """
 
+    READS = (keys.CMD_VEL, keys.NAVIGATION_PAUSED, keys.SAFETY_STATUS, keys.PROPOSAL_TAKEOVER)
+    WRITES = (keys.PROPOSAL_OVERRIDE,)
+    PARAMETERS = (
+        Param("brake_acc", 0.5, "deceleration assumed for the stopping distance", "m/s²", gt=0.0),
+        Param("safety_margin", 0.1, "margin added to robot_geometry.radius", "m", ge=0.0),
+        Param("z_min_filter", 0.0, "points below this height are ignored", "m", dynamic=False),
+        Param("downsample_leaf_size", 0.1, "voxel size of the fused cloud",
+              "m", gt=0.0, dynamic=False),
+    )
+
     def on_initialize(self) -> None:
-        self.brake_acc = read_float(self, "brake_acc", 0.5, positive=True)
-        self.safety_margin = read_float(self, "safety_margin", 0.1)
-        self.z_min_filter = read_float(self, "z_min_filter", 0.0, minimum=None)
-        self.downsample_leaf_size = read_float(self, "downsample_leaf_size", 0.1, positive=True)
+        self.brake_acc = self.params.brake_acc
+        self.safety_margin = self.params.safety_margin
+        self.z_min_filter = self.params.z_min_filter
+        self.downsample_leaf_size = self.params.downsample_leaf_size
         geometry = self.get_robot_geometry()
         self.robot_radius = geometry.radius
         self.robot_height = geometry.height
