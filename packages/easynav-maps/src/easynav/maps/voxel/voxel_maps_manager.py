@@ -56,7 +56,8 @@ class VoxelMapsManager(CostmapMapsManager):
     Every cycle each new valid :class:`PointPerception` (ungrouped, or of the NavState group
     ``perception_group``; a newer stamp than the last inserted from that sensor) is transformed
     into the map frame, its points below ``min_z`` (the floor) dropped, and inserted with ray
-    casting from the sensor origin (the sensor frame's origin in the map frame): voxels crossed become freer, end voxels more occupied.
+    casting from the sensor origin (the sensor frame's origin in the map frame): voxels
+    crossed become freer, end voxels more occupied.
     The 2D projection marks lethal (254) every cell under an occupied voxel that reaches into
     ``[min_z, robot_geometry.height]`` (what the robot would hit; a table top above it is not).
 
@@ -86,6 +87,12 @@ class VoxelMapsManager(CostmapMapsManager):
     )
     READS = (MAP_BASE,)
     WRITES = (MAP_BASE, MAP, MAP_TIME, MAP_OBSTACLE_BOUNDS)
+
+    @classmethod
+    def parameter_declarations(cls):
+        """The declarations, without the CostmapMapsManager's ``map_path_file`` (this class
+        reuses its filters and 2D plumbing, not its map file)."""
+        return tuple(p for p in super().parameter_declarations() if p.name != "map_path_file")
 
     def __init__(self) -> None:
         super().__init__()
