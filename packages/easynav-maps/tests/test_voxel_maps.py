@@ -159,6 +159,20 @@ def test_projection_keeps_only_voxels_between_floor_and_robot_height():
     assert sorted(unpack_keys(edge)[2].tolist()) == [0, 5]
 
 
+def test_band_kept_incrementally_equals_a_full_recompute():
+    rng = np.random.default_rng(7)
+    voxels = BonxaiMap(0.1)
+    voxels.set_band(0.2, 0.6)
+    for k in range(6):  # clouds from a moving sensor: voxels become occupied, then freed
+        origin = np.array([0.3 * k, 0.1, 0.4])
+        voxels.insert_point_cloud(rng.uniform(-2, 2, (300, 3)) * [1, 1, 0.5] + [0, 0, 0.5], origin)
+    expected = band_keys(voxels.occupied_keys(), 0.1, 0.2, 0.6)
+    np.testing.assert_array_equal(np.sort(voxels.band_keys()), np.sort(expected))
+    voxels.set_band(0.0, 1.0)  # a taller robot: rebuilt
+    expected = band_keys(voxels.occupied_keys(), 0.1, 0.0, 1.0)
+    np.testing.assert_array_equal(np.sort(voxels.band_keys()), np.sort(expected))
+
+
 def test_projection_of_large_voxels_covers_their_footprint():
     grid = Costmap2D(np.zeros((20, 20), dtype=np.uint8), 0.05, 0.0, 0.0)
     ix, iy = project_keys(keys_of((1, 1, 0)), 0.3, grid)  # x, y in [0.3, 0.6)

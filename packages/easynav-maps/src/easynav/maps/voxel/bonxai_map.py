@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from easynav.maps.voxel.voxel_projection import band_keys
 from easynav.maps.voxel.voxel_rays import (
     clip_to_range,
     free_keys,
@@ -83,17 +84,31 @@ class BonxaiMap:
         self._observed = np.zeros((0, self._cells), dtype=bool)
         self._coords = np.zeros((0, 3), dtype=np.int64)
         self._band_limits = (0.1, 0.5)
+        self._band: set[int] = set()
 
     # -- band (the interface the voxel maps managers use) ---------------------------------------
     def set_band(self, min_z: float, max_z: float) -> None:
-        """The heights ``[min_z, max_z]`` (m) :meth:`band_keys` selects."""
-        self._band_limits = (float(min_z), float(max_z))
+        """The heights ``[min_z, max_z]`` (m) :meth:`band_keys` selects (rebuilt on a change)."""
+        limits = (float(min_z), float(max_z))
+        if limits != self._band_limits:
+            self._band_limits = limits
+            self._band = set(
+                band_keys(self.occupied_keys(), self.resolution, *limits).tolist()
+            )
 
     def band_keys(self) -> np.ndarray:
-        """Packed keys of the occupied voxels reaching into the band (see :meth:`set_band`)."""
-        from easynav.maps.voxel.voxel_projection import band_keys
+        """Packed keys of the occupied voxels reaching into the band (see :meth:`set_band`),
+        kept up to date by every update: no walk over the whole map per cycle."""
+        return np.fromiter(self._band, dtype=np.int64, count=len(self._band))
 
-        return band_keys(self.occupied_keys(), self.resolution, *self._band_limits)
+    def _refresh_band(self, keys: np.ndarray, rows: np.ndarray, cells: np.ndarray) -> None:
+        inside = _in_band(keys, self.resolution, *self._band_limits)
+        if not inside.any():
+            return
+        occupied = self._log_odds[rows[inside], cells[inside]] > self.log_threshold
+        chosen = keys[inside]
+        self._band.difference_update(chosen[~occupied].tolist())
+        self._band.update(chosen[occupied].tolist())
 
     # -- size -----------------------------------------------------------------------------------
     @property
@@ -154,6 +169,7 @@ class BonxaiMap:
         values = self._log_odds[rows, cells] + np.float32(delta)
         self._log_odds[rows, cells] = np.clip(values, self.log_min, self.log_max)
         self._observed[rows, cells] = True
+        self._refresh_band(keys, rows, cells)
 
     def set_occupied(self, points: np.ndarray) -> None:
         """Mark the voxels of ``points`` ``(N, 3)`` occupied with full confidence (``clamp_max``):
@@ -164,6 +180,7 @@ class BonxaiMap:
         rows, cells = self._rows_of(keys, create=True)
         self._log_odds[rows, cells] = self.log_max
         self._observed[rows, cells] = True
+        self._refresh_band(keys, rows, cells)
 
     def add_hits(self, points: np.ndarray) -> None:
         """One hit in the voxel of each point (each voxel once), no beam."""
@@ -199,11 +216,13 @@ class BonxaiMap:
         return free, hits
 
     def clear(self) -> None:
-        """Forget everything."""
+        """Forget everything (the band limits are kept)."""
+        limits = self._band_limits
         self.__init__(
             self.resolution, _prob(self.log_hit), _prob(self.log_miss), _prob(self.log_min),
             _prob(self.log_max), _prob(self.log_threshold), self.block_bits,
         )
+        self._band_limits = limits
 
     # -- queries --------------------------------------------------------------------------------
     def log_odds_at(self, points: np.ndarray) -> np.ndarray:
@@ -245,6 +264,12 @@ class BonxaiMap:
         """``(N, 3)`` float64 centres of the occupied voxels (m)."""
         ix, iy, iz = unpack_keys(self.occupied_keys())
         return (np.stack((ix, iy, iz), axis=1).astype(np.float64) + 0.5) * self.resolution
+
+
+def _in_band(keys: np.ndarray, resolution: float, min_z: float, max_z: float) -> np.ndarray:
+    """Whether each voxel key reaches into ``[min_z, max_z]`` (see ``band_keys``)."""
+    bottom = unpack_keys(keys)[2] * resolution
+    return (bottom + resolution > min_z) & (bottom <= max_z)
 
 
 def save_bonxai_pcd(voxels: BonxaiMap, path) -> Path:
