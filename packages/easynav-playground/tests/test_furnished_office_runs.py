@@ -6,6 +6,11 @@ not see a low shelf (0.3-0.4 m) and the robot (0.5 m tall) fits under a table (t
   table: every waypoint, no collision;
 - the costmap stack with the 2D laser alone plans through the shelf it cannot see: the run shows
   the contact (a collision at the shelf) or the robot stopped short of the waypoint behind it.
+
+Measured here (2026-11-25, with the costmap planner and AMCL merged in locally, load ~30 on 2
+cores): Bonxai 3/3 waypoints, 0 collisions, 141.6 s simulated; OctoMap (0.1 m voxels) 3/3,
+0 collisions, 131.1 s; laser-only costmap stack: a collision at (8.01, 3.50), the shelf's
+edge, and 0 of 3 waypoints.
 """
 
 from __future__ import annotations
@@ -39,14 +44,14 @@ def _needs_costmap_stack():
         pytest.skip("the costmap AMCL (easynav-localizers) is not installed")
 
 
-def _run(tmp_path, params: Path):
+def _run(tmp_path, params: Path, timeout: float = 600.0):
     out = io.StringIO()
     code = run_demo(
         world="furnished_office",
         params_file=params,
         speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "1.0")),
         output_png=tmp_path / "demo.png",
-        timeout=600.0,
+        timeout=timeout,
         domain_id=int(os.environ["ROS_DOMAIN_ID"]),
         run_dir=tmp_path / "run",
         stream=out,
@@ -79,7 +84,8 @@ def test_laser_only_costmap_stack_runs_into_the_shelf(tmp_path):
     params = PARAMS / "costmap.params.yaml"
     if not params.exists():
         pytest.skip("params/costmap.params.yaml is not in this checkout")
-    code, report, truth = _run(tmp_path, params)
+    # Blocked at the shelf it cannot see, the robot never gets on: a short run shows it.
+    code, report, truth = _run(tmp_path, params, timeout=240.0)
     shelf = next(
         b for b in WorldDescription.resolve("furnished_office").furniture if b.name == "low shelf"
     )

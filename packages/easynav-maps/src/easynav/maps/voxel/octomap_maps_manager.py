@@ -22,7 +22,8 @@ class OctomapMapsManager(VoxelMapsManager):
     works under its name with the original's tree settings (resolution 0.3 m, hit 0.7, miss 0.4,
     clamping 0.12–0.97). Parameters: ``octomap_path_file`` (an OctoMap binary ``.bt``, or a
     point cloud: PCD, PLY with open3d), ``resolution`` and those of :class:`VoxelMapsManager`
-    (``package``, ``occmap_path_file`` extruded to ``wall_height``, ...).
+    (``package``, ``occmap_path_file`` extruded to ``wall_height`` at ``resolution``: unlike
+    Bonxai's, the grid's resolution does not replace it, see ``OCCMAP_SETS_RESOLUTION``).
 
     NavState: ``map.octomap`` (the :class:`OctomapMap`, written when absent, updated in place)
     besides the costmap keys. ROS: ``<alias>/map`` (PointCloud2 of the occupied voxel centres,
@@ -33,10 +34,13 @@ class OctomapMapsManager(VoxelMapsManager):
     """
 
     MAP_FILE_PARAMETER = "octomap_path_file"
+    # An OcTree's insertion holds the interpreter for its whole C++ run: finer voxels than
+    # needed would starve the other plugins' threads, so the configured resolution is kept.
+    OCCMAP_SETS_RESOLUTION = False
     DEFAULT_SAVE_NAME = "easynav_octomap.bt"
     PARAMETERS = (
         Param("octomap_path_file", "", "OctoMap .bt, or a point cloud (PCD; PLY with open3d)"),
-        Param("resolution", 0.3, "voxel edge (replaced by occmap_path_file's resolution)", "m",
+        Param("resolution", 0.3, "voxel edge (an occmap_path_file is extruded at it)", "m",
               gt=0.0),
         *COMMON_PARAMETERS,
     )

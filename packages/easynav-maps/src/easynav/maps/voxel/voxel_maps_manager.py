@@ -77,6 +77,8 @@ class VoxelMapsManager(CostmapMapsManager):
 
     MAP_FILE_PARAMETER = ""
     DEFAULT_SAVE_NAME = "easynav_voxels"
+    #: Whether an occupancy grid's resolution replaces ``resolution`` (the original Bonxai's rule).
+    OCCMAP_SETS_RESOLUTION = True
     TOPICS = (
         Topic("<alias>/map", "sensor_msgs/msg/PointCloud2", "pub", "latched",
               "occupied voxel centres (map frame)"),
@@ -132,7 +134,8 @@ class VoxelMapsManager(CostmapMapsManager):
             voxel_file = self._resolve(getattr(p, map_file_name), map_file_name)
             if occmap is not None:
                 grid = load_costmap_yaml(occmap, frame)
-                resolution = grid.resolution  # as the original: the map's resolution wins
+                if self.OCCMAP_SETS_RESOLUTION:  # as the original Bonxai: the map's wins
+                    resolution = grid.resolution
             if voxel_file is not None:
                 self._voxels = self._load_voxel_file(voxel_file, resolution)
                 self._map_file = voxel_file
