@@ -140,6 +140,28 @@ def derive_params(
     return notes, path_topic
 
 
+LASER_SCAN = "sensor_msgs/msg/LaserScan"
+
+
+def laser_scan_topics(params_path: Path) -> list[str]:
+    """The topics sensors_node reads a ``sensor_msgs/msg/LaserScan`` from, in the order of its
+    ``sensors`` list (the playground's laser must publish there: the original's Kobuki
+    playground uses ``/scan_raw``, this playground ``scan``).
+
+    Raises:
+        FileNotFoundError: no params file.
+    """
+    params = yaml.safe_load(Path(params_path).read_text())
+    sensors = _ros_parameters(params, "sensors_node") if isinstance(params, dict) else None
+    topics = []
+    for name in (sensors or {}).get("sensors", []) or []:
+        if _get(sensors, f"{name}.type") == LASER_SCAN:
+            topic = _get(sensors, f"{name}.topic")
+            if topic:
+                topics.append(str(topic))
+    return topics
+
+
 def planner_plugins(params_path: Path) -> list[str]:
     """The plugin strings of the planner aliases of a params file (empty when none or when the
     file cannot be read: the demo only uses them to choose its reachability warning)."""

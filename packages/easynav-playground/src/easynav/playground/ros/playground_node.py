@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -309,6 +310,7 @@ class PlaygroundNode(Node):
         data["commands_rejected"] = self._rejected_commands
         data["start_pose"] = list(self.start_pose)
         data["holds"] = [list(event) for event in self.sim.hold_events]
+        data["commands"] = [list(event) for event in self.sim.command_events]
         data["obstacles"] = [
             {"name": o.name, "started_at": getattr(o, "started_at", 0.0)}
             for o in self.sim.obstacles
@@ -414,7 +416,7 @@ class PlaygroundNode(Node):
                 " (warned once)"
             )
         try:
-            self.sim.set_command(lin.x, ang.z)
+            self.sim.set_command(lin.x, ang.z, time.time())
         except ValueError as err:
             # A driver must not keep moving on garbage: stop and say why.
             self._rejected_commands += 1

@@ -40,6 +40,11 @@ class Simulation:
     move whatever it is commanded; its velocities are zero and the odometry sees no motion.
     Commands are still taken, so it drives on when released. :attr:`hold_events` lists
     ``(stamp, held)`` for every change, stamped with the first step it applied to.
+    :attr:`command_events` lists ``(stamp, v, w, received)`` of every command the robot took:
+    the step it applied to (simulated time), the values after clamping, and the wall-clock time
+    (``time.time()``) the driver received it, when given: what reached the robot and when, in
+    both clocks (a process's view of simulated time lags on a loaded machine; the wall clock
+    of one machine does not).
 
     The laser is mounted at ``laser_offset`` ``(x, y, yaw)`` in the robot frame, at height
     ``laser_height``. Furniture ``boxes`` (:class:`BoxObstacle`) have heights: the laser sees
@@ -105,6 +110,7 @@ class Simulation:
         self._held = False
         self._was_held = False
         self.hold_events: list[tuple[float, bool]] = []
+        self.command_events: list[tuple[float, float, float]] = []
         self.commands_received = 0
         self._next_scan = scanner.period
         self._next_odom = self.odom_period
@@ -116,8 +122,9 @@ class Simulation:
             )
 
     # ------------------------------------------------------------------ inputs
-    def set_command(self, v: float, w: float) -> None:
-        """Queue a velocity command; the next step applies it.
+    def set_command(self, v: float, w: float, received: float | None = None) -> None:
+        """Queue a velocity command; the next step applies it. ``received``: the wall-clock
+        time the driver got it (kept in :attr:`command_events`).
 
         Raises:
             ValueError: ``v`` or ``w`` is NaN or infinite (nothing is queued).
@@ -125,7 +132,7 @@ class Simulation:
         if not (math.isfinite(v) and math.isfinite(w)):
             raise ValueError(f"Simulation: non-finite velocity command v={v}, w={w}")
         with self._command_lock:
-            self._pending_command = (float(v), float(w))
+            self._pending_command = (float(v), float(w), received)
             self.commands_received += 1
 
     def set_held(self, held: bool) -> None:
@@ -172,6 +179,7 @@ class Simulation:
         robot = self.robot
         if command is not None:
             robot.set_command(command[0], command[1], now)
+            self.command_events.append((now, *robot.command, command[2]))
 
         if held != self._was_held:
             self._was_held = held
