@@ -73,6 +73,19 @@ def test_compiled_walk_matches_the_reference():
     np.testing.assert_array_equal(out[:count], expected)
 
 
+def test_compiled_free_set_matches_the_reference():
+    from easynav.maps.voxel.voxel_rays import free_keys, free_keys_reference
+
+    rng = np.random.default_rng(4)
+    origin = np.array([0.1, 0.2, 0.3])
+    ends = rng.uniform(-3.0, 3.0, (400, 3))
+    crossed = ray_keys(origin, ends, 0.1)  # many repeats near the origin
+    hits = np.unique(point_keys(ends, 0.1))
+    got = free_keys(crossed, hits)
+    assert len(np.unique(got)) == len(got)  # each voxel once
+    np.testing.assert_array_equal(np.sort(got), free_keys_reference(crossed, hits))
+
+
 # -- Bonxai-style map ----------------------------------------------------------------------------
 def test_inserted_cloud_marks_hits_occupied_and_beams_free():
     voxels = BonxaiMap(0.1)
