@@ -138,6 +138,7 @@ def run_demo(
             derived,
             map_yaml=map_yaml.resolve(),
             robot_radius=robot.radius if robot.declared else None,
+            robot_height=robot.height,
         )
         costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
         scan_topics = laser_scan_topics(params_path)
