@@ -10,6 +10,7 @@ from pathlib import Path
 import yaml
 
 from easynav.playground.robot_description import RobotDescription
+from easynav.playground.sim.box_obstacle import BoxObstacle
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.world import World
@@ -40,6 +41,8 @@ class WorldDescription:
           radius: 0.15
           limits: {max_linear_vel: 0.3}
           laser: {max_range: 3.5}
+        furniture:                     # optional: boxes with a height range (BoxObstacle)
+          - {name: low shelf, box: [7.5, 3.0, 8.5, 3.4], z: [0.3, 0.4]}
 
     Thread contract: plain data; build it before starting threads.
     """
@@ -51,6 +54,7 @@ class WorldDescription:
     waypoints_path: Path | None = None
     source: str = ""
     robot: RobotDescription = field(default_factory=RobotDescription)
+    furniture: list[BoxObstacle] = field(default_factory=list)
 
     def make_obstacles(self) -> list[MovingObstacle]:
         """Fresh :class:`MovingObstacle` objects (at their first waypoint); a
@@ -138,7 +142,9 @@ class WorldDescription:
         data = yaml.safe_load(path.read_text())
         if not isinstance(data, dict) or "map" not in data:
             raise ValueError(f"{path}: a world description needs a 'map' key")
-        unknown = set(data) - {"map", "start_pose", "waypoints", "moving_obstacles", "robot"}
+        unknown = set(data) - {
+            "map", "start_pose", "waypoints", "moving_obstacles", "robot", "furniture"
+        }
         if unknown:
             raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
         map_path = path.parent / data["map"]
@@ -158,6 +164,13 @@ class WorldDescription:
             if "robot" in data
             else RobotDescription()
         )
+        furniture = data.get("furniture") or []
+        if not isinstance(furniture, list):
+            raise ValueError(f"{path}: furniture must be a list")
+        boxes = [
+            BoxObstacle.from_dict(spec, f"{path}: furniture[{i}]")
+            for i, spec in enumerate(furniture)
+        ]
         return cls(
             world,
             map_path=map_path,
@@ -166,6 +179,7 @@ class WorldDescription:
             waypoints_path=path.parent / waypoints if waypoints else None,
             source=str(path),
             robot=robot,
+            furniture=boxes,
         )
 
 
