@@ -166,3 +166,19 @@ def test_manager_writes_the_map_under_the_originals_key(tmp_path):
 def test_manager_reports_a_missing_map_naming_it(tmp_path):
     with pytest.raises(PluginConfigurationError, match="gm.package / gm.map_path_file.*gone"):
         make_manager({"map_path_file": str(tmp_path / "gone.yaml")})
+
+
+def test_set_map_replaces_the_map_with_its_layers_derived(tmp_path):
+    x, _ = cell_centres((10, 10), 0.1)
+    path = save_gridmap_npz(GridMap.from_elevation(np.tan(math.radians(10)) * x, 0.1),
+                            tmp_path / "m.npz")
+    manager = make_manager({"map_path_file": str(path)})
+    nav_state = NavState()
+    manager.update(nav_state)
+    np.testing.assert_allclose(nav_state.get("map").layer("traversability"), 2 / 3, atol=1e-9)
+    manager.set_map(GridMap(0.1, 0.0, 0.0, {"elevation": np.zeros((4, 4))}))
+    manager.update(nav_state)
+    assert nav_state.get("map").shape == (4, 4)
+    np.testing.assert_allclose(nav_state.get("map").layer("slope"), 0.0)
+    with pytest.raises(TypeError, match="GridMap"):
+        manager.set_map(np.zeros((3, 3)))
