@@ -140,6 +140,38 @@ def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
     return combos
 
 
+def unmatched_plugins(combos: list[Combination]) -> dict[str, str]:
+    """Installed navigation plugins that are in no combination, each with the reason: the
+    representation it needs or provides has no partner of some axis (e.g. a maps manager whose
+    map no installed localizer can work on)."""
+    used = {p for combo in combos for p in combo.plugins}
+    plugins = navigation_plugins()
+    partners = {
+        kind: {rep for name in names for rep in needed_maps(plugin_class(kind, name))}
+        for kind, names in plugins.items() if kind != "maps manager"
+    }
+    reasons = {}
+    for kind, names in plugins.items():
+        for name in names:
+            if name in used:
+                continue
+            cls = plugin_class(kind, name)
+            if kind == "maps manager":
+                provides = set(provided_maps(cls))
+                missing = [k for k, reps in partners.items()
+                           if reps and not provides & reps and k == "localizer"]
+                reasons[name] = (
+                    f"provides {', '.join(sorted(provides)) or 'nothing'}: no installed "
+                    f"{' or '.join(missing) or 'plugin'} works on it"
+                )
+            else:
+                reasons[name] = (
+                    f"needs {' or '.join(needed_maps(cls))}: its stack lacks a partner of "
+                    "another axis (e.g. a localizer for that map)"
+                )
+    return reasons
+
+
 def covering_slice(combos: list[Combination]) -> list[Combination]:
     """A few combinations that together use every plugin at least once (greedy set cover;
     one world per combination, taking the worlds in turn)."""
@@ -239,8 +271,8 @@ def _num(value, fmt: str) -> str:
     return format(value, fmt)
 
 
-def markdown(outcomes: list[Outcome], header: str) -> str:
-    """docs/matrix.md: one row per run."""
+def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | None = None) -> str:
+    """docs/matrix.md: one row per run, then the plugins that are in no combination."""
     lines = [
         header,
         "",
@@ -261,4 +293,8 @@ def markdown(outcomes: list[Outcome], header: str) -> str:
         )
     green = sum(o.green for o in outcomes)
     lines += ["", f"{green} of {len(outcomes)} runs green.", ""]
+    if unmatched:
+        lines += ["Installed navigation plugins in no combination (nothing to run them with):", ""]
+        lines += [f"- `{name}`: {reason}" for name, reason in sorted(unmatched.items())]
+        lines.append("")
     return "\n".join(lines)

@@ -26,6 +26,7 @@ from matrix import (  # noqa: E402 (the folder is not a package)
     covering_slice,
     markdown,
     run_combination,
+    unmatched_plugins,
 )
 
 
@@ -38,12 +39,15 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--list", action="store_true")
     args = parser.parse_args(argv)
     combos = combinations(tuple(w for w in args.worlds.split(",") if w))
+    unmatched = unmatched_plugins(combos)
     if args.slice:
         combos = covering_slice(combos)
     if args.list:
         for combo in combos:
             print(combo.name)
         print(f"{len(combos)} combinations")
+        for name, reason in sorted(unmatched.items()):
+            print(f"in no combination: {name}: {reason}")
         return 0
     started = datetime.now(timezone.utc)
     outcomes = []
@@ -70,7 +74,7 @@ def main(argv: list[str]) -> int:
         + f", worlds {args.worlds}: {len(combos)} runs",
     ])
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.output).write_text(markdown(outcomes, header))
+    Path(args.output).write_text(markdown(outcomes, header, unmatched))
     print(f"wrote {args.output}")
     return 0 if all(o.green for o in outcomes) else 1
 

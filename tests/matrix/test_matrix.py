@@ -16,18 +16,26 @@ from matrix import (
     navigation_plugins,
     representative_sections,
     run_combination,
+    unmatched_plugins,
 )
 
 from easynav.core.plugins.compatibility import compatible, needed_maps, provided_maps
 
 
-def test_every_installed_navigation_plugin_is_in_some_combination():
+def test_every_installed_navigation_plugin_is_in_a_combination_or_said_why_not():
     combos = combinations(("home",))
     used = {p for combo in combos for p in combo.plugins}
+    unmatched = unmatched_plugins(combos)
     for kind, names in navigation_plugins().items():
         assert names, f"no {kind} installed"
         for name in names:
-            assert name in used, f"{name} ({kind}) is in no compatible combination"
+            assert (name in used) != (name in unmatched), name
+    # The stacks the playground drives with are all in the matrix.
+    for name in ("easynav_simple_maps_manager/SimpleMapsManager",
+                 "easynav_costmap_maps_manager/CostmapMapsManager",
+                 "easynav_costmap_planner/CostmapPlanner",
+                 "easynav_costmap_localizer/AMCLLocalizer"):
+        assert name in used
 
 
 def test_no_combination_pairs_a_plugin_with_a_map_it_cannot_use():
