@@ -4,7 +4,9 @@ from easynav.playground.sim.base_limits import BaseLimits
 from easynav.playground.sim.collision import Collision
 from easynav.playground.sim.collision_checker import CollisionChecker
 from easynav.playground.sim.diff_drive_robot import DiffDriveRobot, integrate_unicycle
+from easynav.playground.sim.gnss_receiver import GnssFix, GnssReceiver
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
+from easynav.playground.sim.imu_sensor import ImuReading, ImuSensor
 from easynav.playground.sim.laser_scanner import LaserScanner
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.ray_casting import cast_rays_discs, cast_rays_grid
@@ -18,7 +20,11 @@ __all__ = [
     "Collision",
     "CollisionChecker",
     "DiffDriveRobot",
+    "GnssFix",
+    "GnssReceiver",
     "GroundTruthRecorder",
+    "ImuReading",
+    "ImuSensor",
     "LaserScanner",
     "MovingObstacle",
     "ScriptedObstacle",
