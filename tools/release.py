@@ -243,8 +243,13 @@ def closure(
     (with the requirement that brought it in; None for the named ones)."""
     seen: dict[str, tuple[Package, Requirement | None]] = {n: (packages[n], None) for n in names}
     todo = [packages[n] for n in names]
-    while todo:
-        for req in todo.pop().requirements:
+    # The named packages' test extras may name siblings too (the kernel's tests inject faults
+    # with easynav-faulty): those are built as well.
+    extra = [r for n in names for r in packages[n].extras.get("test", [])]
+    while todo or extra:
+        reqs = extra or todo.pop().requirements
+        extra = []
+        for req in reqs:
             if req.name in packages and req.name not in seen:
                 seen[req.name] = (packages[req.name], req)
                 todo.append(packages[req.name])

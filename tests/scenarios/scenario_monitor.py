@@ -10,12 +10,14 @@ from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import Log
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
+from easynav.core.ros.converters import time_from_msg
 from easynav.playground.demo.run_monitor import RunMonitor
 
 
 @dataclass(frozen=True)
 class SeenDiagnostic:
-    """One status of a ``diagnostics`` array, with the simulated time it was received."""
+    """One status of a ``diagnostics`` array, with the array's stamp (its publisher's simulated
+    clock when it published)."""
 
     stamp: float
     name: str
@@ -43,7 +45,12 @@ class ScenarioMonitor(RunMonitor):
     - :attr:`reports`: every ``/mitigation`` report;
     - :attr:`commands`: ``(stamp, vx, wz)`` of every velocity command sent to the robot.
 
-    Stamps are the monitor's simulated clock at arrival (``use_sim_time``).
+    Diagnostics and reports carry the stamp their publisher gave them (EasyNav's simulated
+    clock when it published), commands the monitor's simulated clock at arrival. Only
+    publisher stamps are comparable with the playground's record: on a loaded machine this
+    process reads its messages late (seconds, when its queues are deep), so an arrival stamp
+    says when the test looked, not when it happened. What reached the robot, and when, is in
+    the playground's record (``ScenarioRun.commands_applied``).
 
     Thread contract: callbacks in the executor that spins it (the test's thread); read the
     lists from that thread, or under :attr:`lock`.
@@ -63,7 +70,7 @@ class ScenarioMonitor(RunMonitor):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_diagnostics(self, msg: DiagnosticArray) -> None:
-        now = self.sim_now()
+        now = time_from_msg(msg.header.stamp)
         seen = [
             SeenDiagnostic(
                 now,
@@ -80,7 +87,7 @@ class ScenarioMonitor(RunMonitor):
 
     def _on_report(self, msg: Log) -> None:
         with self.lock:
-            self.reports.append(SeenReport(self.sim_now(), int(msg.level), msg.msg))
+            self.reports.append(SeenReport(time_from_msg(msg.stamp), int(msg.level), msg.msg))
 
     def _on_cmd(self, msg) -> None:
         # RunMonitor's cmd_vel / cmd_vel_stamped callback: keep the values too.

@@ -10,6 +10,7 @@ import math
 import os
 import shutil
 import sys
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -187,9 +188,13 @@ class ScenarioRun:
         self.monitor = None
         self.client = None
         self._hold_pub = None
-        self._safety_pub = None
-        self._safety_timer = None
+        self._safety_stop = threading.Event()
+        self._safety_thread: threading.Thread | None = None
+        self._safety_node = None
+        self._safety_executor = None
+        self._safety_lock = threading.Lock()
         self.safety_protective_stop = False
+        self.safety_changes: list[tuple[float, bool, float]] = []
         self.checks: list[Callable[[], None]] = []
 
     # ------------------------------------------------------------------ set-up, tear-down
@@ -223,6 +228,7 @@ class ScenarioRun:
     def __exit__(self, *exc) -> None:
         import rclpy
 
+        self._stop_safety_channel()
         for child in reversed(self.children):  # EasyNav first: it stops the robot
             code = child.stop()
             if child.name == "easynav":
@@ -294,11 +300,11 @@ class ScenarioRun:
 
     # ------------------------------------------------------------------ the robot
     def sim_time(self) -> float:
-        """Simulated time of the latest ground truth (s)."""
-        return self.monitor.truth[0] if self.monitor.truth else 0.0
+        """Simulated time now (s): the monitor's clock (``/clock``, depth 1: the latest)."""
+        return self.monitor.sim_now()
 
     def position(self) -> tuple[float, float]:
-        """True position of the robot."""
+        """True position of the robot (the latest ``ground_truth`` read)."""
         _, x, y, _ = self.monitor.truth
         return x, y
 
@@ -330,30 +336,94 @@ class ScenarioRun:
     # ------------------------------------------------------------------ the safety channel
     def start_safety_channel(self, period: float = 0.05) -> None:
         """Publish the safety channel's status on ``easynav_safety_status`` every ``period``
-        wall seconds (a timer of the monitor, served while the test spins), with
-        ``protective_stop`` = :attr:`safety_protective_stop`.
+        wall seconds, with ``protective_stop`` = :attr:`safety_protective_stop`, from a node
+        and executor of its own in a thread of its own: the certified channel it stands in for
+        does not wait until the test has read its messages (on a loaded machine the test's
+        executor runs seconds behind), and its clock (``/clock``, served by its own executor)
+        stays current.
+
+        Each publication that changes ``protective_stop`` is kept in :attr:`safety_changes`
+        as ``(stamp, protective_stop, wall)``: this process's simulated clock and the wall clock
+        (``time.time()``) when it was sent, the moment EasyNav could first know. (The simulated
+        clock of a busy process lags the playground's; the wall clock is the machine's.)
         """
         from easynav_interfaces.msg import SafetyStatus
+        from rclpy.clock import Clock, ClockType
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+        from rclpy.parameter import Parameter
         from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-        self._safety_pub = self.monitor.create_publisher(
+        node = Node(
+            "scenario_safety_channel",
+            context=self.context,
+            parameter_overrides=[Parameter("use_sim_time", value=True)],
+        )
+        publisher = node.create_publisher(
             SafetyStatus,
             "easynav_safety_status",
             QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE),
         )
-        from rclpy.clock import Clock, ClockType
-
-        wall = Clock(clock_type=ClockType.STEADY_TIME)
+        msg = SafetyStatus()
+        sent: list[bool] = []
 
         def publish() -> None:
-            msg = SafetyStatus()
-            msg.header.stamp = self.monitor.get_clock().now().to_msg()
-            msg.protective_stop = self.safety_protective_stop
+            stop = bool(self.safety_protective_stop)
+            stamp = node.get_clock().now()
+            wall = time.time()
+            msg.header.stamp = stamp.to_msg()
+            msg.protective_stop = stop
             msg.speed_limited = False
-            msg.active_field = "protective" if self.safety_protective_stop else "free"
-            self._safety_pub.publish(msg)
+            msg.active_field = "protective" if stop else "free"
+            publisher.publish(msg)
+            if not sent or sent[-1] != stop:
+                sent.append(stop)
+                with self._safety_lock:
+                    self.safety_changes.append((stamp.nanoseconds * 1e-9, stop, wall))
 
-        self._safety_timer = self.monitor.create_timer(period, publish, clock=wall)
+        node.create_timer(period, publish, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        executor = SingleThreadedExecutor(context=self.context)
+        executor.add_node(node)
+        self._safety_node, self._safety_executor = node, executor
+        self._safety_thread = threading.Thread(
+            target=self._spin_safety_channel, name="safety-channel", daemon=True
+        )
+        self._safety_thread.start()
+
+    def _spin_safety_channel(self) -> None:
+        from rclpy.executors import ExternalShutdownException
+
+        try:
+            while not self._safety_stop.is_set():
+                self._safety_executor.spin_once(timeout_sec=0.05)
+        except ExternalShutdownException:
+            pass
+
+    def set_protective_stop(self, stop: bool) -> tuple[float, float]:
+        """Signal (or release) a protective stop; returns ``(stamp, wall)`` of the first status
+        sent with it (see :meth:`start_safety_channel`; waits for it).
+        """
+        self.safety_protective_stop = bool(stop)
+        found: list[tuple[float, float]] = []
+
+        def sent() -> bool:
+            with self._safety_lock:
+                changes = list(self.safety_changes)
+            if changes and changes[-1][1] == bool(stop):
+                found.append((changes[-1][0], changes[-1][2]))
+                return True
+            return False
+
+        self.spin_until(sent, 10.0, f"the safety channel to send protective_stop={stop}")
+        return found[0]
+
+    def _stop_safety_channel(self) -> None:
+        if self._safety_thread is not None:
+            self._safety_stop.set()
+            self._safety_thread.join(5.0)
+            self._safety_executor.shutdown()
+            self._safety_node.destroy_node()
+            self._safety_thread = None
 
     # ------------------------------------------------------------------ goals
     def send_goals(self, goals: list[tuple[float, float, float]]) -> float:
@@ -382,6 +452,28 @@ class ScenarioRun:
         return self.client.get_state().name, (result.status_message if result else "")
 
     # ------------------------------------------------------------------ figures
+    def commands_applied(self, start: float, end: float) -> list[tuple[float, float, float]]:
+        """``(stamp, v, w)`` of every command the robot took between two stamps, from the
+        playground's record (after the run): what reached the robot, in simulated time.
+        """
+        return [(t, v, w) for t, v, w, _ in self.record.get("commands", []) if start <= t <= end]
+
+    def first_zero_received_after(self, wall: float) -> tuple[float, float] | None:
+        """``(stamp, received)`` of the first zero command the robot received at or after the
+        wall-clock time ``wall`` (the playground's record, after the run), or None.
+        """
+        for t, v, w, received in self.record.get("commands", []):
+            if received is not None and received >= wall and v == 0.0 and w == 0.0:
+                return t, received
+        return None
+
+    def pose_at(self, stamp: float) -> tuple[float, float]:
+        """True position at the last recorded pose not after ``stamp`` (after the run)."""
+        before = [(x, y) for t, x, y, _ in self.truth.true_poses if t <= stamp]
+        if not before:
+            raise ScenarioError(f"no true pose recorded at or before t={stamp:.2f} s")
+        return before[-1]
+
     def true_poses_between(self, start: float, end: float) -> list[tuple[float, float, float]]:
         """``(stamp, x, y)`` of the true trajectory (after the run)."""
         return [(t, x, y) for t, x, y, _ in self.truth.true_poses if start <= t <= end]

@@ -87,7 +87,6 @@ def test_a_held_robot_is_diagnosed_stuck_and_the_mission_aborted_after_the_mitig
             for d in run.monitor.diagnostics
             if d.name.endswith("controller_stuck") and d.level == 0
         ]
-        commands = list(run.monitor.commands)
     # When the playground blocked the wheels (its record), and where.
     held_at = run.record["holds"][0][0]
     held_pose = run.true_poses_between(held_at, held_at + 0.1)[0][1:]
@@ -121,10 +120,10 @@ def test_a_held_robot_is_diagnosed_stuck_and_the_mission_aborted_after_the_mitig
     assert 29.0 < t_cancel - t_human < 35.0  # HumanAssistanceRecovery: timeout 30 s
 
     # AdvanceRecovery commanded the robot forward at its 0.1 m/s, HumanAssistanceRecovery kept
-    # it stopped; it did not move an inch. (Commands are sent on changes: the one in force is
-    # the last one sent.)
+    # it stopped; it did not move an inch. (The command in force is the last one the robot
+    # took: the playground's record, in simulated time.)
     def command_at(stamp: float) -> float:
-        return [vx for t, vx, _ in commands if t <= stamp][-1]
+        return run.commands_applied(0.0, stamp)[-1][1]
 
     assert command_at(t_human - 0.5) == pytest.approx(0.1, abs=1e-6)
     assert command_at(t_cancel - 0.5) == 0.0

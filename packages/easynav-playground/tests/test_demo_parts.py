@@ -162,3 +162,29 @@ def test_derived_params_point_the_costmap_manager_at_the_map_yaml(tmp_path):
     system = params["system_node"]["ros__parameters"]
     assert system["robot_geometry"]["radius"] == 0.15 and system["use_sim_time"] is True
     assert any("robot_geometry.radius = 0.15" in n for n in notes)
+
+
+def test_derived_params_point_the_voxel_maps_managers_at_the_world(tmp_path):
+    import yaml
+
+    source = tmp_path / "voxels.params.yaml"
+    source.write_text(
+        "maps_manager_node:\n  ros__parameters:\n    map_types: [octo, bonxai]\n"
+        "    octo:\n      plugin: easynav_octomap_maps_manager/OctomapMapsManager\n"
+        "      package: easynav_playground\n      octomap_path_file: maps/x.bt\n"
+        "    bonxai:\n      plugin: easynav_bonxai_maps_manager/BonxaiMapsManager\n"
+        "      bonxai_path_file: /some/cloud.pcd\n"
+    )
+    out = tmp_path / "out.yaml"
+    notes, _ = derive_params(
+        source, tmp_path / "w.map", (0, 0, 0), out, map_yaml=tmp_path / "w.yaml",
+        robot_radius=0.2, robot_height=0.5,
+    )
+    maps = yaml.safe_load(out.read_text())["maps_manager_node"]["ros__parameters"]
+    assert maps["octo"]["occmap_path_file"] == str(tmp_path / "w.yaml")
+    assert maps["octo"]["octomap_path_file"] == "" and maps["octo"]["package"] == ""
+    assert maps["bonxai"]["occmap_path_file"] == str(tmp_path / "w.yaml")
+    assert maps["bonxai"]["bonxai_path_file"] == ""
+    system = yaml.safe_load(out.read_text())["system_node"]["ros__parameters"]
+    assert system["robot_geometry"] == {"radius": 0.2, "height": 0.5}
+    assert any("extrudes" in n for n in notes)

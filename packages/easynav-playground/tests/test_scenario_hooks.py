@@ -65,6 +65,19 @@ def test_a_released_robot_drives_on_with_the_command_it_has():
     assert sim.hold_events == [(0.0, True), (pytest.approx(1.0), False)]
 
 
+def test_every_command_the_robot_took_is_recorded_with_the_step_it_applied_to():
+    sim = make_sim()
+    sim.set_command(0.4, 0.1, received=12.5)
+    sim.run_for(1.0)
+    sim.set_command(100.0, 0.0)  # clamped to the base limits, as recorded
+    sim.set_command(0.0, 0.0)  # only the latest pending command is taken
+    sim.run_for(0.5)
+    assert sim.command_events == [(0.0, 0.4, 0.1, 12.5), (pytest.approx(1.0), 0.0, 0.0, None)]
+    sim.set_command(100.0, 0.0)
+    sim.run_for(0.1)
+    assert sim.command_events[-1][1] == sim.robot.limits.max_linear_vel
+
+
 # ---------------------------------------------------------------------- scripted obstacles
 def test_scripted_obstacle_steps_out_when_the_robot_comes_within_start_distance():
     person = ScriptedObstacle(

@@ -374,24 +374,42 @@ def assert_within_limits(samples: list[Sample], limits: RobotLimits) -> None:
             )
 
 
-def assert_ramps_up_from_zero(samples: list[Sample], limits: RobotLimits) -> None:
-    """``samples`` start at rest (or with a first step a ramp allows) and stay within limits:
-    the robot resumes from zero, never from what was commanded before.
+def assert_ramps_up_from_zero(
+    samples: list[Sample], limits: RobotLimits, rest_stamp: float
+) -> None:
+    """``samples`` start at rest and stay within limits: the robot resumes from zero, never
+    from what was commanded before.
+
+    ``rest_stamp``: a stamp (node clock) since which the commanded robot was known to be at
+    rest (EasyNav's ramp start, the release of a stop). The driver does not see every command:
+    the publisher keeps only the latest (depth 1) and a subscription matched a moment late
+    misses the first ones, so the first non-zero command is checked against the last zero
+    received before it or, without one, against ``rest_stamp``, over the time between their
+    stamps.
     """
     assert samples, "no command received"
     moving = [s for s in samples if not s.twist.is_zero()]
     assert moving, "the robot never moved again"
     first = moving[0]
     zeros_before = [s for s in samples if s.stamp < first.stamp]
-    # The first non-zero command is one acceleration step away from zero.
-    reference = zeros_before[-1].stamp if zeros_before else None
-    if reference is not None:
-        dt = first.stamp - reference
-        assert abs(first.twist.vx) <= limits.max_linear_acc * dt + EPS, (first, dt)
-        assert abs(first.twist.wz) <= limits.max_angular_acc * dt + EPS, (first, dt)
-    else:  # no zero received in between: at most one RT cycle's step (dt clamped to 0.1 s)
-        assert abs(first.twist.vx) <= limits.max_linear_acc * 0.1 + EPS, first
+    reference = zeros_before[-1].stamp if zeros_before else rest_stamp
+    dt = first.stamp - reference
+    assert dt >= 0.0, (first, reference)
+    assert abs(first.twist.vx) <= limits.max_linear_acc * (dt + STAMP_EPS) + EPS, (first, dt)
+    assert abs(first.twist.wz) <= limits.max_angular_acc * (dt + STAMP_EPS) + EPS, (first, dt)
     assert_within_limits(samples, limits)
+
+
+def at_rest_since(samples: list[Sample], stamp: float) -> float:
+    """The stamp of the last command received before ``stamp`` when it was a zero: since then
+    the robot has been commanded to stand still (``assert_ramps_up_from_zero``'s reference
+    after a stop). AssertionError when the last command before ``stamp`` was not a zero.
+    """
+    before = [s for s in samples if s.stamp < stamp]
+    assert before and before[-1].twist.is_zero(), (
+        f"the robot was not commanded to stand still before {stamp}: {before[-1:]}"
+    )
+    return before[-1].stamp
 
 
 def full_speed(twist: Twist | None, linear: float, angular: float) -> bool:

@@ -13,6 +13,7 @@ from safety_e2e_harness import (
     SafetyPlc,
     assert_ramps_up_from_zero,
     assert_within_limits,
+    at_rest_since,
     full_speed,
     requires_sched_fifo,
 )
@@ -109,6 +110,8 @@ def test_in_safety_mode_an_old_pose_brakes_the_robot_until_it_is_fresh_again(ros
     fresh_at = time.time()
     localizer_injector(rt).fault = "none"
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
-    assert_ramps_up_from_zero(driver.stamped_after(fresh_at), LIMITS)
+    assert_ramps_up_from_zero(
+        driver.stamped_after(fresh_at), LIMITS, at_rest_since(driver.samples, fresh_at)
+    )
     assert pose_level_is(rt, DiagnosticLevel.OK)
     assert rt.nav_state.get("motion_inhibited") is False

@@ -14,6 +14,7 @@ from safety_e2e_harness import (
     SafetyPlc,
     assert_ramps_up_from_zero,
     assert_within_limits,
+    at_rest_since,
     full_speed,
     requires_sched_fifo,
 )
@@ -28,6 +29,10 @@ pytestmark = pytest.mark.ros
 STATUS_TIMEOUT = 0.5  # s: the PLC publishes every 20 ms, but only while the test spins
 #: Reading the safety channel's state outside safety mode.
 READ_STATUS = {"system_node.safety.status.timeout": STATUS_TIMEOUT}
+
+
+def ramp_start(rt) -> float:
+    return rt.system_node.controller_node.velocity_output.ramp_start
 
 
 def moving(twist) -> bool:
@@ -70,7 +75,8 @@ def test_without_a_status_yet_the_robot_does_not_move_until_the_first_arrives(ro
     released = time.time()
     plc.release()
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
-    assert_ramps_up_from_zero(driver.stamped_after(released), LIMITS)
+    # Nothing was published before (a first zero is not): at rest since EasyNav's ramp start.
+    assert_ramps_up_from_zero(driver.stamped_after(released), LIMITS, ramp_start(rt))
     assert diagnostic_is(rt, DiagnosticLevel.OK)
 
 
@@ -114,7 +120,9 @@ def test_protective_stop_zeroes_every_source_keeps_the_goal_and_resumes_from_zer
     released = time.time()
     plc.release()
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
-    assert_ramps_up_from_zero(driver.stamped_after(released), LIMITS)
+    assert_ramps_up_from_zero(
+        driver.stamped_after(released), LIMITS, at_rest_since(driver.samples, released)
+    )
     assert operator.get_state() == navigating
     assert diagnostic_is(rt, DiagnosticLevel.OK)
 
@@ -137,7 +145,9 @@ def test_no_valid_status_is_a_protective_stop(ros, start_easynav, failure):
     released = time.time()
     plc.release()
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
-    assert_ramps_up_from_zero(driver.stamped_after(released), LIMITS)
+    assert_ramps_up_from_zero(
+        driver.stamped_after(released), LIMITS, at_rest_since(driver.samples, released)
+    )
 
 
 def test_safely_limited_speed_cuts_the_limits_down_and_is_reached_braking(ros, start_easynav):
@@ -188,12 +198,12 @@ def test_speed_limited_from_the_start_is_never_exceeded(ros, start_easynav):
     plc = SafetyPlc(ros)
     plc.limit_speed(0.15, 0.25)
     driver = RobotDriver(ros)
-    start_easynav(system(**READ_STATUS))
+    rt = start_easynav(system(**READ_STATUS))
     assert ros.spin_until(driver.connected, timeout=5.0)
     assert ros.spin_until(lambda: driver.last_is(lambda t: (t.vx, t.wz) == (0.15, 0.25)), 3.0)
     ros.spin_for(0.3)
     assert all(abs(s.twist.vx) <= 0.15 and abs(s.twist.wz) <= 0.25 for s in driver.samples)
-    assert_ramps_up_from_zero(driver.samples, LIMITS)
+    assert_ramps_up_from_zero(driver.samples, LIMITS, ramp_start(rt))
 
 
 @requires_sched_fifo
@@ -206,7 +216,9 @@ def test_in_safety_mode_the_robot_waits_for_the_safety_channel(ros, start_easyna
     released = time.time()
     plc.release()
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
-    assert_ramps_up_from_zero(driver.stamped_after(released), LIMITS)
+    assert_ramps_up_from_zero(
+        driver.stamped_after(released), LIMITS, at_rest_since(driver.samples, released)
+    )
     plc.protective_stop()
     assert ros.spin_until(lambda: driver.last_is(Twist.is_zero), timeout=2.0)
     assert only_zeros_after_last_full_speed(driver)

@@ -13,6 +13,7 @@ from safety_e2e_harness import (
     RobotDriver,
     assert_ramps_up_from_zero,
     assert_within_limits,
+    at_rest_since,
     full_speed,
 )
 from safety_e2e_params import (
@@ -98,7 +99,9 @@ def test_stale_or_invalid_commands_brake_to_zero_after_cmd_timeout_until_command
     recovered_at = time.time()
     injector(rt).fault = "none"
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
-    assert_ramps_up_from_zero(driver.stamped_after(recovered_at), LIMITS)
+    assert_ramps_up_from_zero(
+        driver.stamped_after(recovered_at), LIMITS, at_rest_since(driver.samples, recovered_at)
+    )
     status = diagnostic(rt, "cmd_vel")
     assert status.level == DiagnosticLevel.OK
     assert status.message == "velocity commands flowing again"
@@ -142,7 +145,9 @@ def test_throwing_controller_is_contained_the_robot_brakes_and_resumes(ros, star
     recovered_at = time.time()
     injector(rt).fault = "none"
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=3.0)
-    assert_ramps_up_from_zero(driver.stamped_after(recovered_at), LIMITS)
+    assert_ramps_up_from_zero(
+        driver.stamped_after(recovered_at), LIMITS, at_rest_since(driver.samples, recovered_at)
+    )
     assert diagnostic(rt, "ctrl.error").level == DiagnosticLevel.OK
 
 

@@ -66,6 +66,20 @@ def test_a_new_controller_command_ramps_up_within_the_acceleration():
     assert robot.drive(0.5, 1.0).twist.vx == 0.5
 
 
+def test_ramp_start_is_the_first_cycle_and_every_output_is_within_the_ramp_from_it():
+    robot = Robot()
+    assert robot.out.ramp_start is None
+    robot.cycle()
+    start = robot.out.ramp_start
+    assert start == robot.now
+    robot.drive(0.5, 0.3)
+    assert robot.out.ramp_start == start
+    ramp = LIMITS.max_linear_acc
+    assert all(abs(t.vx) <= ramp * (at - start) + 1e-9 for at, t in robot.published)
+    robot.out.reset()
+    assert robot.out.ramp_start is None
+
+
 def test_a_controller_repeating_the_same_stamped_command_brakes_after_cmd_timeout():
     robot = Robot(cmd_timeout=0.5)
     robot.drive(0.5, 1.0)

@@ -1,9 +1,12 @@
-"""EasyNav controllers: SimpleController (carrot following with PIDs).
+"""EasyNav controllers: SimpleController (carrot following with PIDs), MPC, SeReST and VFF.
 
-The algorithm (:class:`SimplePathFollower`, :class:`PIDController`) is plain Python/numpy; the
-plugin (``easynav.controllers.simple_controller``) is not imported here.
+The algorithms (:class:`SimplePathFollower`, :class:`PIDController`, :class:`MPCOptimizer`,
+:class:`SerestTracker`, :class:`VffVectors`) are plain Python/numpy (scipy for the MPC's
+solver, imported when solving); the plugins (``easynav.controllers.*_controller``) are not
+imported here.
 """
 
+from easynav.controllers.mpc_optimizer import MPCOptimizer
 from easynav.controllers.path_follower import (
     ARRIVED,
     FINAL_ROTATION,
@@ -13,13 +16,18 @@ from easynav.controllers.path_follower import (
     carrot_on_path,
 )
 from easynav.controllers.pid_controller import PIDController
+from easynav.controllers.serest_tracker import SerestTracker
+from easynav.controllers.vff_vectors import VffVectors
 
 __all__ = [
     "ARRIVED",
     "FINAL_ROTATION",
     "FOLLOWING",
     "NO_PATH",
+    "MPCOptimizer",
     "PIDController",
+    "SerestTracker",
     "SimplePathFollower",
+    "VffVectors",
     "carrot_on_path",
 ]

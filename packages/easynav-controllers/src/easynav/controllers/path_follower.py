@@ -44,6 +44,32 @@ def carrot_on_path(path_xy: np.ndarray, position: np.ndarray, look_ahead: float)
     return path_xy[segment] + fraction * ab[segment]
 
 
+def path_segments(path_xy_yaw: np.ndarray) -> list[tuple[int, int, int]]:
+    """The path cut at its cusps: ``(first, last, direction)`` index ranges (inclusive), where
+    ``direction`` is +1 when the poses are driven forward (the next pose lies ahead of a pose's
+    yaw) and -1 in reverse (it lies behind, as on a Reeds–Shepp path). A cusp pose ends one
+    segment and starts the next. Zero-length steps take the direction of the step before.
+    """
+    path = np.asarray(path_xy_yaw, dtype=float)
+    if len(path) < 2:
+        return [(0, max(len(path) - 1, 0), 1)]
+    step = np.diff(path[:, :2], axis=0)
+    along = step[:, 0] * np.cos(path[:-1, 2]) + step[:, 1] * np.sin(path[:-1, 2])
+    directions = np.where(along < 0.0, -1, 1)
+    moving = np.hypot(step[:, 0], step[:, 1]) > 1e-9
+    for i in range(1, len(directions)):
+        if not moving[i]:
+            directions[i] = directions[i - 1]
+    segments = []
+    first = 0
+    for i in range(1, len(directions)):
+        if directions[i] != directions[i - 1]:
+            segments.append((first, i, int(directions[i - 1])))
+            first = i
+    segments.append((first, len(path) - 1, int(directions[-1])))
+    return segments
+
+
 def _limit_change(
     target: float, previous: float, speed_up: float, slow_down: float, dt: float
 ) -> float:
@@ -61,11 +87,19 @@ class SimplePathFollower:
     Each step: the carrot is the point ``look_ahead_dist`` along the path beyond the robot's
     projection on it; ``w = PID_angular(angle to the carrot)`` and
     ``v = max(0, PID_linear(distance to the carrot) - k_rot·|w|)`` (slower while turning; never
-    backwards). Within ``tolerance_dist`` of the last pose the robot stops and turns to its yaw
+    backwards, unless ``allow_reversing``). Within ``tolerance_dist`` of the last pose the robot
+    stops and turns to its yaw
     (``FINAL_ROTATION``, kept until 2·``tolerance_dist`` so estimate noise does not toggle it),
     then reports ``ARRIVED`` within ``final_goal_angle_tolerance`` and commands zero. Speeds are
     clamped to the robot limits and changed within their accelerations (speeding up) and
     decelerations (slowing down).
+
+    With ``allow_reversing`` (off by default) a path is cut at its cusps (:func:`path_segments`)
+    and followed one segment at a time: a segment whose poses face away from the direction of
+    travel (a Reeds–Shepp reverse) is driven backwards, the robot's back towards the carrot
+    (``v`` < 0, within ``min_linear_vel``), and the next segment starts once the robot is within
+    ``cusp_tolerance`` of the cusp. A robot whose limits forbid reversing (``min_linear_vel`` 0)
+    drives every segment forward.
 
     Thread contract: owned by the controller plugin, RT thread only; not locked.
     Exceptions: :class:`ValueError` for parameters out of range (naming them).
@@ -79,12 +113,15 @@ class SimplePathFollower:
         k_rot: float = 0.5,
         linear_gains: tuple[float, float, float] = (0.95, 0.03, 0.08),
         angular_gains: tuple[float, float, float] = (1.5, 0.03, 0.08),
+        allow_reversing: bool = False,
+        cusp_tolerance: float = 0.1,
     ) -> None:
         for name, value in (
             ("look_ahead_dist", look_ahead_dist),
             ("tolerance_dist", tolerance_dist),
             ("final_goal_angle_tolerance", final_goal_angle_tolerance),
             ("k_rot", k_rot),
+            ("cusp_tolerance", cusp_tolerance),
         ):
             if not math.isfinite(value) or value < 0.0:
                 raise ValueError(f"{name} = {value} must be finite and >= 0")
@@ -92,6 +129,8 @@ class SimplePathFollower:
         self.tolerance_dist = float(tolerance_dist)
         self.final_goal_angle_tolerance = float(final_goal_angle_tolerance)
         self.k_rot = float(k_rot)
+        self.allow_reversing = bool(allow_reversing)
+        self.cusp_tolerance = float(cusp_tolerance)
         # Outputs are saturated later by the robot limits; the PIDs only clamp their integral.
         self.linear_pid = PIDController(*linear_gains, max_output=math.inf)
         self.angular_pid = PIDController(*angular_gains, max_output=math.inf)
@@ -100,6 +139,10 @@ class SimplePathFollower:
         self._goal: tuple[float, float, float] | None = None
         self._final_rotation = False
         self._state = NO_PATH
+        # Reversing: the path being followed (its identity), its segments, the current one.
+        self._segments_of: np.ndarray | None = None
+        self._segments: list[tuple[int, int, int]] = []
+        self._segment = 0
 
     def reset(self) -> None:
         """Forget the PID state, the last command and the final-rotation mode."""
@@ -109,6 +152,30 @@ class SimplePathFollower:
         self._goal = None
         self._final_rotation = False
         self._state = NO_PATH
+        self._segments_of = None
+        self._segments = []
+        self._segment = 0
+
+    def _active_segment(
+        self, path: np.ndarray, x: float, y: float
+    ) -> tuple[np.ndarray, int]:
+        """The part of ``path`` to follow now and its direction (+1 forward, -1 reverse)."""
+        if self._segments_of is None or not (
+            self._segments_of is path
+            or (self._segments_of.shape == path.shape and np.array_equal(self._segments_of, path))
+        ):
+            self._segments_of = path
+            self._segments = path_segments(path)
+            self._segment = 0
+        # Past a cusp once the robot is close enough to it (never back: the path may pass the
+        # same place in both directions).
+        while self._segment < len(self._segments) - 1:
+            last = self._segments[self._segment][1]
+            if math.hypot(path[last, 0] - x, path[last, 1] - y) > self.cusp_tolerance:
+                break
+            self._segment += 1
+        first, last, direction = self._segments[self._segment]
+        return path[first : last + 1], direction
 
     def compute(
         self,
@@ -147,7 +214,17 @@ class SimplePathFollower:
         dist_goal = math.hypot(goal[0] - x, goal[1] - y)
         yaw_error = normalize_angle(goal[2] - yaw)
 
-        if dist_goal <= stop_dist or (self._final_rotation and dist_goal <= 2.0 * stop_dist):
+        piece, direction, on_last = path, 1, True
+        if self.allow_reversing:
+            piece, direction = self._active_segment(path, x, y)
+            # A path with cusps may pass the goal before its last segment: not arrived there.
+            on_last = self._segment == len(self._segments) - 1
+            if limits.min_linear_vel >= 0.0:
+                direction = 1  # this robot cannot reverse: drive the segment forward
+
+        if on_last and (
+            dist_goal <= stop_dist or (self._final_rotation and dist_goal <= 2.0 * stop_dist)
+        ):
             self._final_rotation = True
             self.linear_pid.reset()
             if abs(yaw_error) <= stop_yaw:
@@ -163,16 +240,19 @@ class SimplePathFollower:
             state = FINAL_ROTATION
         else:
             self._final_rotation = False
-            carrot = carrot_on_path(path[:, :2], np.array((x, y)), self.look_ahead_dist)
+            carrot = carrot_on_path(piece[:, :2], np.array((x, y)), self.look_ahead_dist)
             dx, dy = carrot[0] - x, carrot[1] - y
-            heading_error = normalize_angle(math.atan2(dy, dx) - yaw)
+            # In reverse the robot's back leads: it steers its back towards the carrot.
+            facing = yaw if direction > 0 else yaw + math.pi
+            heading_error = normalize_angle(math.atan2(dy, dx) - facing)
             w_target = self.angular_pid.output(heading_error, dt)
-            v_target = max(
+            v_target = direction * max(
                 0.0, self.linear_pid.output(math.hypot(dx, dy), dt) - self.k_rot * abs(w_target)
             )
             state = FOLLOWING
 
-        v_target = min(v_target, max(limits.max_linear_vel, 0.0))
+        v_target = max(min(v_target, max(limits.max_linear_vel, 0.0)),
+                       min(limits.min_linear_vel, 0.0))
         w_max = max(limits.max_angular_vel, 0.0)
         w_target = min(max(w_target, -w_max), w_max)
         v_target = _limit_change(

@@ -21,7 +21,7 @@ from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
 #: The follower's parameters (defaults of the original, CATALOGUE §SimpleController).
 FOLLOWER_PARAMETERS = ("look_ahead_dist", "tolerance_dist", "final_goal_angle_tolerance", "k_rot",
                        "linear_kp", "linear_ki", "linear_kd", "angular_kp", "angular_ki",
-                       "angular_kd")
+                       "angular_kd", "allow_reversing", "cusp_tolerance")
 
 
 class SimpleController(ControllerMethodBase):
@@ -57,6 +57,11 @@ class SimpleController(ControllerMethodBase):
         Param("angular_kp", 1.5, "angular PID: proportional gain"),
         Param("angular_ki", 0.03, "angular PID: integral gain"),
         Param("angular_kd", 0.08, "angular PID: derivative gain"),
+        Param("allow_reversing", False, "drive path segments that face backwards (cusps of a "
+              "Reeds-Shepp path) in reverse, within robot_limits.min_linear_vel. Not in the "
+              "original"),
+        Param("cusp_tolerance", 0.1, "distance to a cusp at which the next segment starts", "m",
+              ge=0.0),
     )
     TOPICS = ()
     READS = (PATH, ROBOT_POSE, GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW)
@@ -88,6 +93,8 @@ class SimpleController(ControllerMethodBase):
             p.k_rot,
             (p.linear_kp, p.linear_ki, p.linear_kd),
             (p.angular_kp, p.angular_ki, p.angular_kd),
+            allow_reversing=p.allow_reversing,
+            cusp_tolerance=p.cusp_tolerance,
         )
 
     def on_parameter_changed(self, name: str, value: object) -> None:

@@ -7,15 +7,27 @@ import math
 import cv2
 import numpy as np
 
-from easynav.maps import SimpleMap
+#: Cost of a lethal cell in a Costmap2D: the cells a laser point hits (the original's 254).
+LETHAL = 254
+
+
+def occupied_cells(grid) -> np.ndarray:
+    """The obstacle cells of a map as a ``(height, width)`` bool array: a :class:`SimpleMap`'s
+    occupied cells, or a Costmap2D's lethal (254) cells (unknown 255 and the inflated 253 are
+    not obstacles a laser can hit)."""
+    cells = getattr(grid, "cells", None)
+    if cells is not None:
+        return np.asarray(cells, dtype=bool)
+    return np.asarray(grid.data) == LETHAL
 
 
 def _wrap(angles: np.ndarray) -> np.ndarray:
     return (angles + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def likelihood_field(grid: SimpleMap, sigma: float) -> np.ndarray:
-    """How much a point in each cell counts as a hit: ``exp(-d² / 2σ²)`` for a cell whose centre
+def likelihood_field(grid, sigma: float) -> np.ndarray:
+    """How much a point in each cell of ``grid`` (a :class:`SimpleMap` or a Costmap2D, see
+    :func:`occupied_cells`) counts as a hit: ``exp(-d² / 2σ²)`` for a cell whose centre
     is ``d`` metres from the nearest occupied cell centre (1 on occupied cells); ``sigma`` 0
     gives exact hits (1 on occupied cells, 0 elsewhere). ``(height, width)`` float32.
 
@@ -25,9 +37,10 @@ def likelihood_field(grid: SimpleMap, sigma: float) -> np.ndarray:
     """
     if not math.isfinite(sigma) or sigma < 0.0:
         raise ValueError(f"hit sigma = {sigma} must be finite and >= 0")
-    if sigma == 0.0 or not grid.cells.any():
-        return grid.cells.astype(np.float32)
-    free = (~grid.cells).astype(np.uint8)
+    cells = occupied_cells(grid)
+    if sigma == 0.0 or not cells.any():
+        return cells.astype(np.float32)
+    free = (~cells).astype(np.uint8)
     distance = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) * grid.resolution
     return np.exp(-0.5 * np.square(distance / sigma)).astype(np.float32)
 
@@ -35,18 +48,22 @@ def likelihood_field(grid: SimpleMap, sigma: float) -> np.ndarray:
 def hit_fractions(
     poses: np.ndarray,
     points_xy: np.ndarray,
-    grid: SimpleMap,
+    grid,
     field: np.ndarray | None = None,
     chunk: int = 128,
+    compiled: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     """For each particle pose ``(x, y, yaw)``: the fraction of ``points_xy`` (robot frame) that
-    hit occupied cells of ``grid``, and how many landed on the map at all.
+    hit occupied cells of ``grid`` (a :class:`SimpleMap` or a Costmap2D, see
+    :func:`occupied_cells`), and how many landed on the map at all.
 
     ``field`` (from :func:`likelihood_field`) says how much a point in each cell counts as a
     hit; None counts exact hits on occupied cells (the original's score). A particle whose
     points all fall off the map scores 0. Vectorised over particles × points, in float32 cell
     units and ``chunk`` particles at a time, which keeps the intermediate arrays in cache (4–5×
-    faster than one float64 pass for 1000 particles).
+    faster than one float64 pass for 1000 particles). With numba installed (and ``compiled``)
+    the same scoring runs as one compiled loop (``_scoring_numba``), several times faster again;
+    this numpy version is its reference.
     """
     n = len(poses)
     fractions = np.zeros(n)
@@ -54,9 +71,23 @@ def hit_fractions(
     if n == 0 or len(points_xy) == 0 or grid.width == 0 or grid.height == 0:
         return fractions, possible
     if field is None:
-        field = grid.cells.astype(np.float32)
-    elif field.shape != grid.cells.shape:
-        raise ValueError(f"likelihood field shape {field.shape} != map shape {grid.cells.shape}")
+        field = occupied_cells(grid).astype(np.float32)
+    elif field.shape != (grid.height, grid.width):
+        raise ValueError(
+            f"likelihood field shape {field.shape} != map shape {(grid.height, grid.width)}"
+        )
+    kernel = _compiled_scoring() if compiled else None
+    if kernel is not None:
+        return kernel(
+            np.ascontiguousarray(poses, dtype=np.float64),
+            np.ascontiguousarray(points_xy[:, :2], dtype=np.float64),
+            np.ascontiguousarray(field, dtype=np.float32).ravel(),
+            grid.width,
+            grid.height,
+            float(grid.origin_x),
+            float(grid.origin_y),
+            float(grid.resolution),
+        )
     inv = 1.0 / grid.resolution
     px = (points_xy[:, 0] * inv).astype(np.float32)[None, :]
     py = (points_xy[:, 1] * inv).astype(np.float32)[None, :]
@@ -80,6 +111,22 @@ def hit_fractions(
         possible[a:b] = count
         np.divide(hits.sum(axis=1, dtype=np.float64), count, out=fractions[a:b], where=count > 0)
     return fractions, possible
+
+
+_SCORING = None
+
+
+def _compiled_scoring():
+    """The numba scoring kernel, compiled on first use (None without numba)."""
+    global _SCORING
+    if _SCORING is None:
+        try:
+            from easynav.localizers._scoring_numba import score_kernel
+        except ImportError:
+            _SCORING = False
+        else:
+            _SCORING = score_kernel
+    return _SCORING or None
 
 
 class ParticleFilter2D:
@@ -196,15 +243,28 @@ class ParticleFilter2D:
         """``1 / Σ w²``: N for uniform weights, 1 when one particle holds them all."""
         return float(1.0 / np.square(self.weights).sum())
 
-    def resample(self) -> None:
-        """Low-variance resampling: N evenly spaced pointers with one random offset."""
+    def resample(self, count: int | None = None) -> None:
+        """Low-variance resampling: ``count`` (default: the current N) evenly spaced pointers
+        with one random offset; a different ``count`` resizes the cloud (KLD sampling)."""
         n = len(self.poses)
-        positions = (self.rng.random() + np.arange(n)) / n
+        m = n if count is None else int(count)
+        if m < 1:
+            raise ValueError(f"resample count = {m} must be >= 1")
+        positions = (self.rng.random() + np.arange(m)) / m
         cumulative = np.cumsum(self.weights)
         cumulative[-1] = 1.0  # guard against round-off
         indices = np.searchsorted(cumulative, positions, side="right")
         self.poses = self.poses[np.minimum(indices, n - 1)]
-        self.weights = np.full(n, 1.0 / n)
+        self.weights = np.full(m, 1.0 / m)
+
+    def replace(self, poses: np.ndarray) -> None:
+        """Take ``poses`` (``(M, 3)``) as the cloud, uniform weights (global localisation)."""
+        poses = np.array(poses, dtype=float).reshape(-1, 3)
+        if len(poses) < 1 or not np.all(np.isfinite(poses)):
+            raise ValueError("replacement particles must be finite and at least one")
+        poses[:, 2] = _wrap(poses[:, 2])
+        self.poses = poses
+        self.weights = np.full(len(poses), 1.0 / len(poses))
 
     def reseed_worst_half(self, min_noise_xy: float, min_noise_yaw: float) -> None:
         """Redraw the lower-weight half around the upper half (see the class docstring)."""

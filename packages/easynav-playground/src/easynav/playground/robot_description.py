@@ -20,6 +20,21 @@ LASER_KEYS = (
     "z",
     "yaw",
 )
+#: Keys of the ``lidar`` section (each is the playground node parameter ``lidar.<key>``).
+LIDAR_KEYS = (
+    "rings",
+    "beams",
+    "min_elevation",
+    "max_elevation",
+    "min_range",
+    "max_range",
+    "rate",
+    "noise_std",
+    "x",
+    "y",
+    "z",
+    "yaw",
+)
 #: The playground's robot when a world declares none (its parameter defaults).
 DEFAULT_RADIUS = 0.2
 
@@ -35,6 +50,8 @@ class RobotDescription:
           radius: 0.15                                   # collision disc (m)
           limits: {max_linear_vel: 0.3, max_angular_vel: 1.8}
           laser: {beams: 360, max_range: 3.5}
+          height: 0.5                                    # top of the robot (m): collisions
+          lidar: {rings: 16, max_range: 8.0}             # a 3D lidar (none without the key)
 
     The playground takes them as the defaults of its ``robot_radius``, ``base.*`` and
     ``laser.*`` parameters (an explicit parameter still wins); the demo writes ``radius`` into
@@ -47,6 +64,8 @@ class RobotDescription:
     limits: dict[str, float] = field(default_factory=dict)
     laser: dict[str, float] = field(default_factory=dict)
     declared: bool = False
+    height: float | None = None  # None: not declared (the playground's robot_height default)
+    lidar: dict[str, float] | None = None
 
     @classmethod
     def from_dict(cls, data: object, source: str) -> RobotDescription:
@@ -59,7 +78,7 @@ class RobotDescription:
         """
         if not isinstance(data, dict):
             raise ValueError(f"{source}: robot must be a mapping, got {data!r}")
-        unknown = set(data) - {"radius", "limits", "laser"}
+        unknown = set(data) - {"radius", "limits", "laser", "height", "lidar"}
         if unknown:
             raise ValueError(f"{source}: robot has unknown keys {sorted(unknown)}")
         radius = _number(data.get("radius", DEFAULT_RADIUS), f"{source}: robot.radius")
@@ -78,7 +97,20 @@ class RobotDescription:
             if not float(laser["beams"]).is_integer():
                 raise ValueError(f"{source}: robot.laser.beams must be an integer")
             laser["beams"] = int(laser["beams"])
-        return cls(radius, limits, laser, declared=True)
+        height = None
+        if "height" in data:
+            height = _number(data["height"], f"{source}: robot.height")
+            if height <= 0.0:
+                raise ValueError(f"{source}: robot.height must be > 0, got {height}")
+        lidar = None
+        if "lidar" in data:
+            lidar = _section(data.get("lidar") or {}, LIDAR_KEYS, "lidar", source)
+            for key in ("rings", "beams"):
+                if key in lidar:
+                    if not float(lidar[key]).is_integer() or lidar[key] < 1:
+                        raise ValueError(f"{source}: robot.lidar.{key} must be an integer >= 1")
+                    lidar[key] = int(lidar[key])
+        return cls(radius, limits, laser, declared=True, height=height, lidar=lidar)
 
     def parameter_defaults(self) -> dict[str, object]:
         """The playground node parameters this robot sets (``robot_radius``, ``base.*``,
@@ -86,8 +118,13 @@ class RobotDescription:
         if not self.declared:
             return {}
         values: dict[str, object] = {"robot_radius": self.radius}
+        if self.height is not None:
+            values["robot_height"] = self.height
         values.update({f"base.{k}": v for k, v in self.limits.items()})
         values.update({f"laser.{k}": v for k, v in self.laser.items()})
+        if self.lidar is not None:
+            values["lidar.enabled"] = True
+            values.update({f"lidar.{k}": v for k, v in self.lidar.items()})
         return values
 
 

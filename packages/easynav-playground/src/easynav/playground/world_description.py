@@ -10,6 +10,7 @@ from pathlib import Path
 import yaml
 
 from easynav.playground.robot_description import RobotDescription
+from easynav.playground.sim.box_obstacle import BoxObstacle
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.world import World
@@ -47,6 +48,8 @@ class WorldDescription:
         imu: {rate: 50.0, gyro_bias: 0.002}     # optional: the robot has an IMU (imu.* params)
         gnss: {rate: 5.0, noise: 0.2, outages: [[60, 75]]}  # optional: a GNSS receiver
                                                 # (gnss.* params; needs geodetic_origin)
+        furniture:                     # optional: boxes with a height range (BoxObstacle)
+          - {name: low shelf, box: [7.5, 3.0, 8.5, 3.4], z: [0.3, 0.4]}
 
     Thread contract: plain data; build it before starting threads.
     """
@@ -61,6 +64,7 @@ class WorldDescription:
     geodetic_origin: tuple[float, float, float] | None = None
     imu: dict | None = None
     gnss: dict | None = None
+    furniture: list[BoxObstacle] = field(default_factory=list)
 
     def sensor_parameter_defaults(self) -> dict[str, object]:
         """Playground parameter defaults of this world's IMU and GNSS (``imu.enabled``,
@@ -164,8 +168,10 @@ class WorldDescription:
         data = yaml.safe_load(path.read_text())
         if not isinstance(data, dict) or "map" not in data:
             raise ValueError(f"{path}: a world description needs a 'map' key")
-        unknown = set(data) - {"map", "start_pose", "waypoints", "moving_obstacles", "robot",
-                               "geodetic_origin", "imu", "gnss"}
+        unknown = set(data) - {
+            "map", "start_pose", "waypoints", "moving_obstacles", "robot", "furniture",
+            "geodetic_origin", "imu", "gnss",
+        }
         if unknown:
             raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
         map_path = path.parent / data["map"]
@@ -202,6 +208,13 @@ class WorldDescription:
             sensors[name] = spec
         if "gnss" in sensors and origin is None:
             raise ValueError(f"{path}: gnss needs a geodetic_origin")
+        furniture = data.get("furniture") or []
+        if not isinstance(furniture, list):
+            raise ValueError(f"{path}: furniture must be a list")
+        boxes = [
+            BoxObstacle.from_dict(spec, f"{path}: furniture[{i}]")
+            for i, spec in enumerate(furniture)
+        ]
         return cls(
             world,
             map_path=map_path,
@@ -213,6 +226,7 @@ class WorldDescription:
             geodetic_origin=origin,
             imu=sensors.get("imu"),
             gnss=sensors.get("gnss"),
+            furniture=boxes,
         )
 
 

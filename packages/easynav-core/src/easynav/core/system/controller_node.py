@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 from typing import Any
@@ -28,10 +29,12 @@ from easynav.core.nav_state_keys import (
     SAFETY_STATUS,
     SPEED_LIMIT,
 )
+from easynav.core.plugins.colision_checker import SEARCH_RANGE, ColisionChecker
 from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
 from easynav.core.ros.converters import header_to_msg, twist_to_msg
+from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.system.component_node import ComponentNode, ConfigurationError
 from easynav.core.system.node_declarations import CONTROLLER_NODE_PARAMETERS
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
@@ -52,7 +55,9 @@ class ControllerNode(ComponentNode):
     Every RT cycle: the controller computes ``cmd_vel`` (when due or triggered); after the
     recovery system proposed, :meth:`publish_cycle` selects (mux), smooths, guards and publishes.
     Parameters: ``controller_types``, ``<alias>.*``, ``robot_limits.*``, ``cmd_timeout`` (0.5 s),
-    ``cmd_vel_keepalive_period`` (0.0 s), ``use_cmd_vel_stamped`` (false).
+    ``cmd_vel_keepalive_period`` (0.0 s), ``use_cmd_vel_stamped`` (false), ``colision_checker.*``
+    (with ``colision_checker.active``, each new controller command is checked by
+    :class:`ColisionChecker` against every point perception and zeroed on a collision).
 
     Thread contract: ``cycle_rt``/``publish_cycle`` in the RT thread; ``brake`` in the thread that
     deactivates or shuts down, while the RT loop no longer cycles.
@@ -74,6 +79,7 @@ class ControllerNode(ComponentNode):
         self.last_published = Twist()
         self.published_any = False
         self.last_publish_monotonic: float | None = None
+        self.colision_checker: ColisionChecker | None = None
         system.robot_limits = self.limits_in_force
 
     # -- configuration --------------------------------------------------------------------------
@@ -89,11 +95,23 @@ class ControllerNode(ComponentNode):
             stamped = self.forced_use_stamped
         self.use_stamped = stamped
         self._check_limits()
+        self._configure_colision_checker()
+        if values["colision_checker.debug_markers"]:
+            self.get_logger().warning(
+                "colision_checker.debug_markers: markers are not published in this version"
+            )
 
     def _check_limits(self) -> None:
         errors = self.robot_limits.validation_errors(f"{self.get_name()}.robot_limits.")
         if errors:
             raise ConfigurationError("; ".join(errors))
+
+    def _configure_colision_checker(self) -> None:
+        # The checker of the colision_checker.* values in force (None while inactive).
+        values = self.node_values
+        self.colision_checker = (
+            ColisionChecker.from_parameters(values) if values["colision_checker.active"] else None
+        )
 
     def check_node_parameter(self, name: str, value: Any) -> None:
         if name == "cmd_timeout":
@@ -113,8 +131,8 @@ class ControllerNode(ComponentNode):
                 raise ParameterValueError("; ".join(errors))
 
     def on_node_parameter_changed(self, name: str, value: Any) -> None:
-        """A runtime change of ``robot_limits.*`` or ``cmd_timeout`` is in force from the next
-        RT cycle."""
+        """A runtime change of ``robot_limits.*``, ``cmd_timeout`` or ``colision_checker.*`` is in
+        force from the next RT cycle."""
         if name.startswith("robot_limits."):
             self.robot_limits = replace(
                 self.robot_limits, **{name.removeprefix("robot_limits."): float(value)}
@@ -123,6 +141,8 @@ class ControllerNode(ComponentNode):
             self.cmd_timeout = float(value)
             if self.velocity_output is not None:
                 self.velocity_output.set_cmd_timeout(self.cmd_timeout)
+        elif name.startswith("colision_checker."):
+            self._configure_colision_checker()
 
     def after_plugins_loaded(self) -> None:
         self._apply_deprecated_limits()
@@ -150,7 +170,10 @@ class ControllerNode(ComponentNode):
         robot_limits parameter too, so what is read back (and restored after a mitigation) is
         the limit in force."""
         for lp in self.plugins:
-            for old, new in DEPRECATED_LIMIT_PARAMETERS.items():
+            # A controller whose original named its limits otherwise lists them in
+            # DEPRECATED_LIMITS (MPC: max_linear_velocity; VFF: max_speed).
+            names = DEPRECATED_LIMIT_PARAMETERS | getattr(lp.plugin, "DEPRECATED_LIMITS", {})
+            for old, new in names.items():
                 old_name = f"{lp.alias}.{old}"
                 if not self.params.is_set(old_name) or old not in lp.plugin.params:
                     continue
@@ -218,6 +241,43 @@ class ControllerNode(ComponentNode):
                 # A failing controller stops the robot: a new zero command (braked smoothly).
                 now = self.now_seconds()
                 self.nav_state.set(CMD_VEL, TwistStamped(Header(now, ""), Twist()))
+            elif self.colision_checker is not None:
+                self.check_collision()
+
+    def check_collision(self) -> None:
+        """Zero the controller's command when it runs into a point (``colision_checker``).
+
+        Every point perception (grouped or not, as the original) within 2 m, fused to the
+        robot frame and downsampled. RT thread.
+        """
+        checker = self.colision_checker
+        if checker is None or not self.nav_state.has(CMD_VEL):
+            return
+        command = self.nav_state.get(CMD_VEL)
+        twist = command.twist
+        if twist.vx == 0.0:
+            return
+        frame = self.robot_frame()
+        points = (
+            PointPerceptionsOps(self.nav_state.get_by_type(PointPerception),
+                                logger=self.get_logger())
+            .fuse(frame)
+            .filter((-SEARCH_RANGE, -SEARCH_RANGE, math.nan),
+                    (SEARCH_RANGE, SEARCH_RANGE, math.nan))
+            .downsample(checker.downsample_leaf_size)
+            .as_points()
+        )
+        collision = checker.check(points, twist.vx, twist.wz)
+        if collision is None:
+            return
+        self.get_logger().warning(
+            f"colision_checker: command (v={twist.vx:.2f}, w={twist.wz:.2f}) stopped: point "
+            f"({collision.point[0]:.2f}, {collision.point[1]:.2f}) within "
+            f"{checker.robot_radius:g} m in {collision.time:.2f} s",
+            throttle_duration_sec=1.0,
+        )
+        stamp = max(self.now_seconds(), command.header.stamp)
+        self.nav_state.set(CMD_VEL, TwistStamped(Header(stamp, command.header.frame_id), Twist()))
 
     def publish_cycle(self) -> None:
         """Mux → smoother → guard → publish. RT thread, after the recovery system's RT cycle."""

@@ -19,6 +19,9 @@ from easynav.core.system.cycle_loop import CycleLoop
 from easynav.core.system.process_tuning import tune_malloc
 from easynav.core.system.system_node import SystemNode
 
+#: SCHED_FIFO priority of the non-RT loop with ``use_real_time``: below the RT loop's 80.
+NORT_PRIORITY = 70
+
 
 @dataclass
 class RuntimeResult:
@@ -34,7 +37,8 @@ class EasyNavRuntime:
     - ``start()``: rclpy context with the params file, system_node and its sub-nodes, one
       SingleThreadedExecutor per loop (MultiThreadedExecutor is unusable in this rclpy), the RT
       loop (sensors_node and its subscriptions; SCHED_FIFO 80 when ``use_real_time``) and the
-      non-RT loop (every other node: goal topics, lifecycle services, plugin topics), then
+      non-RT loop (every other node: goal topics, lifecycle services, plugin topics; SCHED_FIFO
+      70 when ``use_real_time``, so it is not preempted while it holds the GIL), then
       configure and activate. Returns False with ``error`` set when configure fails.
     - ``wait()``: blocks until a stop is requested (signal, recovery system, safety supervisor).
     - ``stop()``: controlled stop: deactivate (the controller brakes within the deceleration
@@ -117,12 +121,20 @@ class EasyNavRuntime:
             on_realtime_result=self._realtime_result,
             on_error=lambda exc: self.logger.error(f"RT cycle: {type(exc).__name__}: {exc}"),
         )
+        # The non-RT loop is SCHED_FIFO too, below the RT loop: both share the GIL, and a thread of
+        # normal priority that other processes preempt while it holds the GIL keeps the RT thread
+        # waiting for the GIL (priority inversion). Measured on a loaded 2-core machine
+        # (bench_rt_loop.py): p99 start-period error 27-57x the bare loop's with a normal non-RT
+        # thread, 0.4-1.0x with SCHED_FIFO 70; nice -10 only brings it to 11x.
         self.nort_loop = CycleLoop(
             "easynav_nort",
             float(params["freq"]),
             self.nort_executor,
             lambda triggered: node.cycle(),
             float(params["spin_time_nort"]),
+            realtime=bool(params["use_real_time"]),
+            priority=NORT_PRIORITY,
+            on_realtime_result=self._realtime_result,
             on_error=lambda exc: self.logger.error(f"non-RT cycle: {type(exc).__name__}: {exc}"),
         )
         self.rt_loop.start()

@@ -8,6 +8,7 @@ goal manager) and system_node's safety.* group. The nodes read them with ``read_
 from __future__ import annotations
 
 from easynav.core.goals.goal_manager_params import GOAL_MANAGER_PARAMETERS
+from easynav.core.plugins.colision_checker import COLISION_CHECKER_PARAMETERS
 from easynav.core.plugins.declarations import Param
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS
 
@@ -40,6 +41,8 @@ CONTROLLER_NODE_PARAMETERS = (
           "republish the last command at this period, with a QoS deadline (0: off)", "s",
           ge=0.0, dynamic=False),
     Param("use_cmd_vel_stamped", False, "publish TwistStamped on cmd_vel_stamped", dynamic=False),
+    # The controller base's collision check (the original's names, one "l").
+    *COLISION_CHECKER_PARAMETERS,
 )
 
 

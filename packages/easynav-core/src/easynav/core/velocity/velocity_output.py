@@ -80,6 +80,7 @@ class VelocityOutput:
         self._base_limits = limits
         self._cut: tuple[float, float] | None = None
         self._last_now: float | None = None
+        self._ramp_start: float | None = None
         self._last_published = _ZERO
         self._last_publish_time: float | None = None
 
@@ -93,6 +94,14 @@ class VelocityOutput:
     def current(self) -> Twist:
         """The last command output (a new object)."""
         return self._smoother.current
+
+    @property
+    def ramp_start(self) -> float | None:
+        """Node-clock time of the first :meth:`cycle` since construction or :meth:`reset` (None
+        before it): the output is at rest then, and no command after it is further from zero
+        than the acceleration limits allow over the time since.
+        """
+        return self._ramp_start
 
     @property
     def cmd_timeout(self) -> float:
@@ -197,6 +206,7 @@ class VelocityOutput:
         self._smoother.reset()
         self._guard.reset()
         self._last_now = None
+        self._ramp_start = None
         self._last_published = _ZERO
         self._last_publish_time = None
 
@@ -222,6 +232,7 @@ class VelocityOutput:
         last = self._last_now
         self._last_now = now
         if last is None:
+            self._ramp_start = now
             return 0.0
         dt = now - last
         if dt <= 0.0:

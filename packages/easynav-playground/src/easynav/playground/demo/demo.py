@@ -24,7 +24,11 @@ from pathlib import Path
 from typing import TextIO
 
 from easynav.playground.demo.child_process import ChildProcess
-from easynav.playground.demo.params_patch import derive_params, planner_plugins
+from easynav.playground.demo.params_patch import (
+    derive_params,
+    laser_scan_topics,
+    planner_plugins,
+)
 from easynav.playground.demo.progress_line import ProgressLine
 from easynav.playground.demo.run_plot import plot_run
 from easynav.playground.demo.run_summary import RunSummary
@@ -134,8 +138,10 @@ def run_demo(
             derived,
             map_yaml=map_yaml.resolve(),
             robot_radius=robot.radius if robot.declared else None,
+            robot_height=robot.height,
         )
         costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
+        scan_topics = laser_scan_topics(params_path)
         easynav = _easynav_command()
     except (OSError, ValueError, DemoError) as err:
         print(f"easynav demo: {err}", file=sys.stderr)
@@ -189,6 +195,10 @@ def run_demo(
     ]
     if not moving_obstacles:
         playground_argv.append("--no-obstacles")
+    if scan_topics and scan_topics[0].lstrip("/") != "scan":
+        # The params file is left as written: the playground's laser is remapped instead.
+        playground_argv += ["--ros-args", "-r", f"scan:={scan_topics[0]}"]
+        print(f"  - the playground's laser publishes on {scan_topics[0]}", file=out)
     children = [
         ChildProcess("playground", playground_argv, env, run_path / "playground.log"),
         ChildProcess("easynav", [*easynav, "run", str(derived)], env, run_path / "easynav.log"),

@@ -11,6 +11,12 @@ from easynav.core.cli.params_file import load_ros_yaml
 SIMPLE_MAPS_MANAGER = "easynav_simple_maps_manager/SimpleMapsManager"
 #: Maps managers that load a ROS map-server YAML through ``package`` / ``map_path_file``.
 MAP_SERVER_MAPS_MANAGERS = ("easynav_costmap_maps_manager/CostmapMapsManager",)
+#: Voxel maps managers that extrude a map-server YAML given as ``occmap_path_file``, and the
+#: parameter naming their own map file (emptied, so that the world's map is the one loaded).
+VOXEL_MAPS_MANAGERS = {
+    "easynav_octomap_maps_manager/OctomapMapsManager": "octomap_path_file",
+    "easynav_bonxai_maps_manager/BonxaiMapsManager": "bonxai_path_file",
+}
 
 
 def _get(section: dict, dotted: str, default=None):
@@ -51,14 +57,18 @@ def derive_params(
     out_path: Path,
     map_yaml: Path | None = None,
     robot_radius: float | None = None,
+    robot_height: float | None = None,
 ) -> tuple[list[str], str | None]:
     """Write ``out_path``: the params file with the world's map and start pose, sim time on.
 
     - every ``SimpleMapsManager`` alias loads ``map_file`` (a ``.map``; ``package`` emptied);
     - every ``CostmapMapsManager`` alias loads ``map_yaml`` (the world's map-server YAML;
       ``package`` emptied) when given;
+    - every ``OctomapMapsManager`` / ``BonxaiMapsManager`` alias extrudes ``map_yaml``
+      (``occmap_path_file``; its own map file and ``package`` emptied) when given;
     - every localizer alias with an ``initial_pose`` starts at ``start_pose``;
-    - ``system_node.robot_geometry.radius`` is ``robot_radius`` when given (the world's robot);
+    - ``system_node.robot_geometry.radius`` is ``robot_radius`` and ``.height`` is
+      ``robot_height`` when given (the world's robot);
     - ``use_sim_time: true`` on every node (the playground's /clock is the time).
 
     Returns the notes of what was changed and the planner's debug path topic (None without a
@@ -79,6 +89,11 @@ def derive_params(
         if _get(system, "robot_geometry.radius") != robot_radius:
             _set(system, "robot_geometry.radius", float(robot_radius))
             notes.append(f"system_node.robot_geometry.radius = {robot_radius:g}, the world's robot")
+    if robot_height is not None:
+        system = params.setdefault("system_node", {}).setdefault("ros__parameters", {})
+        if _get(system, "robot_geometry.height") != robot_height:
+            _set(system, "robot_geometry.height", float(robot_height))
+            notes.append(f"system_node.robot_geometry.height = {robot_height:g}, the world's robot")
 
     for node, section in params.items():
         if isinstance(section, dict) and isinstance(section.get("ros__parameters"), dict):
@@ -93,6 +108,11 @@ def derive_params(
             _set(maps, f"{alias}.package", "")
             _set(maps, f"{alias}.map_path_file", str(map_file))
             notes.append(f"maps_manager_node.{alias} loads the world's map {map_file}")
+        elif plugin in VOXEL_MAPS_MANAGERS and map_yaml is not None:
+            _set(maps, f"{alias}.package", "")
+            _set(maps, f"{alias}.{VOXEL_MAPS_MANAGERS[plugin]}", "")
+            _set(maps, f"{alias}.occmap_path_file", str(map_yaml))
+            notes.append(f"maps_manager_node.{alias} extrudes the world's map {map_yaml}")
         elif plugin in MAP_SERVER_MAPS_MANAGERS and map_yaml is not None:
             _set(maps, f"{alias}.package", "")
             _set(maps, f"{alias}.map_path_file", str(map_yaml))
@@ -118,6 +138,28 @@ def derive_params(
     path_topic = f"/planner_node/{planner_types[0]}/path" if planner_types else None
     Path(out_path).write_text(yaml.safe_dump(params, sort_keys=False))
     return notes, path_topic
+
+
+LASER_SCAN = "sensor_msgs/msg/LaserScan"
+
+
+def laser_scan_topics(params_path: Path) -> list[str]:
+    """The topics sensors_node reads a ``sensor_msgs/msg/LaserScan`` from, in the order of its
+    ``sensors`` list (the playground's laser must publish there: the original's Kobuki
+    playground uses ``/scan_raw``, this playground ``scan``).
+
+    Raises:
+        FileNotFoundError: no params file.
+    """
+    params = yaml.safe_load(Path(params_path).read_text())
+    sensors = _ros_parameters(params, "sensors_node") if isinstance(params, dict) else None
+    topics = []
+    for name in (sensors or {}).get("sensors", []) or []:
+        if _get(sensors, f"{name}.type") == LASER_SCAN:
+            topic = _get(sensors, f"{name}.topic")
+            if topic:
+                topics.append(str(topic))
+    return topics
 
 
 def planner_plugins(params_path: Path) -> list[str]:

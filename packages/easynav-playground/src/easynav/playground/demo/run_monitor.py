@@ -38,7 +38,9 @@ def compose(a: tuple[float, float, float], b: tuple[float, float, float]):
 class RunMonitor(Node):
     """Subscribes what the demo reports on, with ``use_sim_time`` (stamps are simulated time).
 
-    - ``ground_truth``: the true pose and speed (live progress);
+    - ``ground_truth``: the true pose and speed (live progress): only the latest one is kept
+      (depth 1), so a busy process reads where the robot is, not where it was a hundred
+      messages ago (the complete trajectory is the playground's record);
     - ``/tf``: ``map -> odom`` (from EasyNav's localizer) composed with ``odom ->
       base_footprint`` (from the playground) gives EasyNav's pose estimate at each odometry
       stamp, recorded in :attr:`estimates` for the localisation error;
@@ -80,7 +82,8 @@ class RunMonitor(Node):
             reliability=ReliabilityPolicy.RELIABLE,
             durability=DurabilityPolicy.TRANSIENT_LOCAL,
         )
-        self.create_subscription(Odometry, "ground_truth", self._on_truth, reliable)
+        latest = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+        self.create_subscription(Odometry, "ground_truth", self._on_truth, latest)
         self.create_subscription(TFMessage, "/tf", self._on_tf, reliable)
         self.create_subscription(Twist, "cmd_vel", self._on_cmd, reliable)
         self.create_subscription(TwistStamped, "cmd_vel_stamped", self._on_cmd, reliable)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,7 @@ from easynav.playground.sim import (
     GnssReceiver,
     ImuSensor,
     LaserScanner,
+    Lidar3D,
     Simulation,
     WheelOdometry,
 )
@@ -37,6 +39,7 @@ DEFAULT_PARAMETERS: dict[str, object] = {
     "step": 0.005,
     "start_pose": [math.nan, math.nan, math.nan],
     "robot_radius": 0.2,
+    "robot_height": 0.5,
     "cmd_timeout": 0.0,
     "odom_rate": 50.0,
     "moving_obstacles": True,
@@ -47,6 +50,7 @@ DEFAULT_PARAMETERS: dict[str, object] = {
     "robot_footprint_frame": "base_footprint",
     "robot_frame": "base_link",
     "laser_frame": "base_laser",
+    "lidar_frame": "base_lidar",
     "base_link_height": 0.05,
     "laser.beams": 360,
     "laser.fov": 2.0 * math.pi,
@@ -58,6 +62,19 @@ DEFAULT_PARAMETERS: dict[str, object] = {
     "laser.y": 0.0,
     "laser.z": 0.25,
     "laser.yaw": 0.0,
+    "lidar.enabled": False,
+    "lidar.rings": 16,
+    "lidar.beams": 180,
+    "lidar.min_elevation": -0.26,
+    "lidar.max_elevation": 0.26,
+    "lidar.min_range": 0.2,
+    "lidar.max_range": 8.0,
+    "lidar.rate": 5.0,
+    "lidar.noise_std": 0.01,
+    "lidar.x": 0.0,
+    "lidar.y": 0.0,
+    "lidar.z": 0.45,
+    "lidar.yaw": 0.0,
     "odometry.linear_scale": 1.01,
     "odometry.angular_scale": 0.99,
     "odometry.linear_noise": 0.01,
@@ -96,10 +113,12 @@ _LATCHED = QoSProfile(
 class PlaygroundNode(Node):
     """The playground robot: runs a :class:`Simulation` in simulated time and talks ROS.
 
-    Publishes ``/clock`` (every step), ``scan`` (``laser.rate``), ``odom`` and the ``odom ->
-    base_footprint`` transform on ``tf`` (``odom_rate``), ``ground_truth`` (true pose in the map
-    frame, same rate), the static ``base_footprint -> base_link -> base_laser`` transforms on
-    ``tf_static``, ``collisions`` (latched JSON: count and the last collision) and the world on
+    Publishes ``/clock`` (every step), ``scan`` (``laser.rate``), ``points`` (the 3D lidar's
+    PointCloud2 in ``lidar_frame``, ``lidar.rate``, with ``lidar.enabled``), ``odom`` and the
+    ``odom -> base_footprint`` transform on ``tf`` (``odom_rate``), ``ground_truth`` (true pose
+    in the map frame, same rate), the static ``base_footprint -> base_link -> base_laser`` (and
+    ``-> base_lidar``) transforms on ``tf_static``, ``collisions`` (latched JSON: count and the
+    last collision) and the world on
     ``playground/world`` (latched OccupancyGrid). Subscribes ``cmd_vel`` (Twist),
     ``cmd_vel_stamped`` (TwistStamped) and ``playground/hold`` (std_msgs/Bool, transient local:
     hold the robot in place, wheels blocked; the ``hold`` parameter is the initial state). It
@@ -141,8 +160,9 @@ class PlaygroundNode(Node):
         if any(math.isnan(v) for v in start):
             start = list(self.description.start_pose)
         self.start_pose = tuple(start)
-        rng_scan, rng_odom, rng_imu, rng_gnss = (
-            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(4)
+        # Children by index: adding sensors at the end leaves the earlier streams unchanged.
+        rng_scan, rng_odom, rng_lidar, rng_imu, rng_gnss = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(5)
         )
         limits = BaseLimits(**{k: float(p(f"base.{k}")) for k in BaseLimits.__slots__})
         robot = DiffDriveRobot(*self.start_pose, limits=limits, cmd_timeout=float(p("cmd_timeout")))
@@ -164,6 +184,20 @@ class PlaygroundNode(Node):
             rng=rng_odom,
         )
         obstacles = self.description.make_obstacles() if p("moving_obstacles") else []
+        self.lidar = None
+        if bool(p("lidar.enabled")):
+            self.lidar = Lidar3D(
+                rings=int(p("lidar.rings")),
+                beams=int(p("lidar.beams")),
+                min_elevation=float(p("lidar.min_elevation")),
+                max_elevation=float(p("lidar.max_elevation")),
+                min_range=float(p("lidar.min_range")),
+                max_range=float(p("lidar.max_range")),
+                rate=float(p("lidar.rate")),
+                noise_std=float(p("lidar.noise_std")),
+                rng=rng_lidar,
+            )
+        self._lidar_offset = tuple(float(p(f"lidar.{k}")) for k in ("x", "y", "z", "yaw"))
         self.sim = Simulation(
             self.description.world,
             robot,
@@ -174,6 +208,11 @@ class PlaygroundNode(Node):
             step=float(p("step")),
             odom_rate=float(p("odom_rate")),
             laser_offset=(float(p("laser.x")), float(p("laser.y")), float(p("laser.yaw"))),
+            boxes=self.description.furniture,
+            robot_height=float(p("robot_height")),
+            laser_height=float(p("laser.z")),
+            lidar=self.lidar,
+            lidar_offset=self._lidar_offset,
         )
         self.record_path = str(p("record"))
         self.frames = {
@@ -184,6 +223,7 @@ class PlaygroundNode(Node):
                 "robot_footprint_frame",
                 "robot_frame",
                 "laser_frame",
+                "lidar_frame",
             )
         }
         self.sim.set_held(bool(p("hold")))
@@ -192,6 +232,11 @@ class PlaygroundNode(Node):
 
         self._clock_pub = self.create_publisher(Clock, "/clock", _RELIABLE)
         self._scan_pub = self.create_publisher(messages.LaserScan, "scan", _RELIABLE)
+        self._cloud_pub = None
+        if self.lidar is not None:
+            from sensor_msgs.msg import PointCloud2
+
+            self._cloud_pub = self.create_publisher(PointCloud2, "points", _RELIABLE)
         self._odom_pub = self.create_publisher(messages.Odometry, "odom", _RELIABLE)
         self._truth_pub = self.create_publisher(messages.Odometry, "ground_truth", _RELIABLE)
         self._collisions_pub = self.create_publisher(String, "collisions", _LATCHED)
@@ -238,6 +283,7 @@ class PlaygroundNode(Node):
         self.frames["gnss_frame"] = str(p("gnss_frame"))
 
         self.sim.on_scan.append(self._publish_scan)
+        self.sim.on_cloud.append(self._publish_cloud)
         self.sim.on_odometry.append(self._publish_odometry)
         self.sim.on_collision.append(self._publish_collision)
         self._loop = FixedRateLoop(
@@ -251,8 +297,17 @@ class PlaygroundNode(Node):
     def start(self) -> None:
         """Publish the latched and static data, then start the simulation loop thread."""
         f = self.frames
+        lidar_tf = []
+        if self.lidar is not None:
+            ox, oy, oz, oyaw = self._lidar_offset
+            lidar_tf.append(
+                messages.planar_transform_msg(
+                    0.0, f["robot_frame"], f["lidar_frame"], ox, oy,
+                    oz - self._base_link_height, oyaw,
+                )
+            )
         self._tf_static.send_transform(
-            [
+            lidar_tf + [
                 messages.planar_transform_msg(
                     0.0,
                     f["robot_footprint_frame"],
@@ -310,6 +365,7 @@ class PlaygroundNode(Node):
         data["commands_rejected"] = self._rejected_commands
         data["start_pose"] = list(self.start_pose)
         data["holds"] = [list(event) for event in self.sim.hold_events]
+        data["commands"] = [list(event) for event in self.sim.command_events]
         data["obstacles"] = [
             {"name": o.name, "started_at": getattr(o, "started_at", 0.0)}
             for o in self.sim.obstacles
@@ -342,6 +398,13 @@ class PlaygroundNode(Node):
     def _publish_scan(self, stamp: float, ranges: np.ndarray) -> None:
         self._scan_pub.publish(
             messages.laser_scan_msg(self.scanner, ranges, stamp, self.frames["laser_frame"])
+        )
+
+    def _publish_cloud(self, stamp: float, points: np.ndarray) -> None:
+        from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
+
+        self._cloud_pub.publish(
+            point_cloud2_from_points(points, self.frames["lidar_frame"], stamp)
         )
 
     def _publish_odometry(self, stamp: float) -> None:
@@ -418,7 +481,7 @@ class PlaygroundNode(Node):
                 " (warned once)"
             )
         try:
-            self.sim.set_command(lin.x, ang.z)
+            self.sim.set_command(lin.x, ang.z, time.time())
         except ValueError as err:
             # A driver must not keep moving on garbage: stop and say why.
             self._rejected_commands += 1

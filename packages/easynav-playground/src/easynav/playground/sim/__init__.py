@@ -1,6 +1,7 @@
 """The playground's simulator core: plain numpy, no ROS."""
 
 from easynav.playground.sim.base_limits import BaseLimits
+from easynav.playground.sim.box_obstacle import BoxObstacle, rasterize_boxes
 from easynav.playground.sim.collision import Collision
 from easynav.playground.sim.collision_checker import CollisionChecker
 from easynav.playground.sim.diff_drive_robot import DiffDriveRobot, integrate_unicycle
@@ -8,6 +9,7 @@ from easynav.playground.sim.gnss_receiver import GnssFix, GnssReceiver
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.sim.imu_sensor import ImuReading, ImuSensor
 from easynav.playground.sim.laser_scanner import LaserScanner
+from easynav.playground.sim.lidar_3d import Lidar3D
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.ray_casting import cast_rays_discs, cast_rays_grid
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
@@ -17,6 +19,7 @@ from easynav.playground.sim.world import World
 
 __all__ = [
     "BaseLimits",
+    "BoxObstacle",
     "Collision",
     "CollisionChecker",
     "DiffDriveRobot",
@@ -26,6 +29,7 @@ __all__ = [
     "ImuReading",
     "ImuSensor",
     "LaserScanner",
+    "Lidar3D",
     "MovingObstacle",
     "ScriptedObstacle",
     "Simulation",
@@ -34,4 +38,5 @@ __all__ = [
     "cast_rays_discs",
     "cast_rays_grid",
     "integrate_unicycle",
+    "rasterize_boxes",
 ]

@@ -8,11 +8,13 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from easynav.playground.sim.box_obstacle import BoxObstacle, rasterize_boxes
 from easynav.playground.sim.collision import Collision
 from easynav.playground.sim.collision_checker import CollisionChecker
 from easynav.playground.sim.diff_drive_robot import DiffDriveRobot
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.sim.laser_scanner import LaserScanner
+from easynav.playground.sim.lidar_3d import Lidar3D
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.wheel_odometry import WheelOdometry
 from easynav.playground.sim.world import World
@@ -20,6 +22,7 @@ from easynav.playground.sim.world import World
 ScanCallback = Callable[[float, np.ndarray], None]
 StampCallback = Callable[[float], None]
 CollisionCallback = Callable[[Collision], None]
+CloudCallback = Callable[[float, np.ndarray], None]
 
 
 class Simulation:
@@ -37,8 +40,18 @@ class Simulation:
     move whatever it is commanded; its velocities are zero and the odometry sees no motion.
     Commands are still taken, so it drives on when released. :attr:`hold_events` lists
     ``(stamp, held)`` for every change, stamped with the first step it applied to.
+    :attr:`command_events` lists ``(stamp, v, w, received)`` of every command the robot took:
+    the step it applied to (simulated time), the values after clamping, and the wall-clock time
+    (``time.time()``) the driver received it, when given: what reached the robot and when, in
+    both clocks (a process's view of simulated time lags on a loaded machine; the wall clock
+    of one machine does not).
 
-    The laser is mounted at ``laser_offset`` ``(x, y, yaw)`` in the robot frame.
+    The laser is mounted at ``laser_offset`` ``(x, y, yaw)`` in the robot frame, at height
+    ``laser_height``. Furniture ``boxes`` (:class:`BoxObstacle`) have heights: the laser sees
+    those crossing its plane, the robot hits those reaching below ``robot_height`` (the world
+    grid's walls are full height for both). An optional 3D ``lidar`` (:class:`Lidar3D`) at
+    ``lidar_offset`` ``(x, y, z, yaw)`` sees everything; ``on_cloud(stamp, points)`` gets its
+    points in the lidar frame at its rate.
 
     Thread contract: :meth:`step` and the callbacks run in one thread (the simulation loop);
     :meth:`set_command` and :meth:`set_held` may be called from any thread (they only store
@@ -60,16 +73,27 @@ class Simulation:
         odom_rate: float = 50.0,
         laser_offset: tuple[float, float, float] = (0.1, 0.0, 0.0),
         recorder: GroundTruthRecorder | None = None,
+        boxes: Sequence[BoxObstacle] = (),
+        robot_height: float = 0.5,
+        laser_height: float = 0.25,
+        lidar: Lidar3D | None = None,
+        lidar_offset: tuple[float, float, float, float] = (0.0, 0.0, 0.45, 0.0),
     ) -> None:
         for name, value in (("step", step), ("odom_rate", odom_rate)):
             if not (math.isfinite(value) and value > 0.0):
                 raise ValueError(f"Simulation: {name} must be finite and > 0, got {value}")
         self.world = world
+        self.boxes = list(boxes)
+        # What the 2D laser sees and what the robot's body hits (walls are full height).
+        self.laser_world = rasterize_boxes(world, self.boxes, laser_height, laser_height)
+        self.collision_world = rasterize_boxes(world, self.boxes, 0.0, robot_height)
         self.robot = robot
         self.scanner = scanner
+        self.lidar = lidar
+        self.lidar_offset = tuple(float(v) for v in lidar_offset)
         self.odometry = odometry
         self.obstacles = list(obstacles)
-        self.checker = CollisionChecker(world, robot_radius)
+        self.checker = CollisionChecker(self.collision_world, robot_radius)
         self.step_size = float(step)
         self.odom_period = 1.0 / float(odom_rate)
         self.laser_offset = tuple(float(v) for v in laser_offset)
@@ -79,11 +103,14 @@ class Simulation:
         self.on_scan: list[ScanCallback] = []
         self.on_odometry: list[StampCallback] = []
         self.on_collision: list[CollisionCallback] = []
+        self.on_cloud: list[CloudCallback] = []
+        self._next_cloud = lidar.period if lidar is not None else math.inf
         self._command_lock = threading.Lock()
         self._pending_command: tuple[float, float] | None = None
         self._held = False
         self._was_held = False
         self.hold_events: list[tuple[float, bool]] = []
+        self.command_events: list[tuple[float, float, float]] = []
         self.commands_received = 0
         self._next_scan = scanner.period
         self._next_odom = self.odom_period
@@ -97,8 +124,9 @@ class Simulation:
             )
 
     # ------------------------------------------------------------------ inputs
-    def set_command(self, v: float, w: float) -> None:
-        """Queue a velocity command; the next step applies it.
+    def set_command(self, v: float, w: float, received: float | None = None) -> None:
+        """Queue a velocity command; the next step applies it. ``received``: the wall-clock
+        time the driver got it (kept in :attr:`command_events`).
 
         Raises:
             ValueError: ``v`` or ``w`` is NaN or infinite (nothing is queued).
@@ -106,7 +134,7 @@ class Simulation:
         if not (math.isfinite(v) and math.isfinite(w)):
             raise ValueError(f"Simulation: non-finite velocity command v={v}, w={w}")
         with self._command_lock:
-            self._pending_command = (float(v), float(w))
+            self._pending_command = (float(v), float(w), received)
             self.commands_received += 1
 
     def set_held(self, held: bool) -> None:
@@ -141,7 +169,17 @@ class Simulation:
 
     def scan_now(self) -> np.ndarray:
         """Take a scan from the current pose (no scheduling, no callbacks)."""
-        return self.scanner.scan(self.world, *self.laser_pose(), self.obstacles)
+        return self.scanner.scan(self.laser_world, *self.laser_pose(), self.obstacles)
+
+    def cloud_now(self) -> np.ndarray:
+        """Take a 3D lidar scan from the current pose (lidar frame; needs a lidar)."""
+        r = self.robot
+        ox, oy, oz, oyaw = self.lidar_offset
+        c, s = math.cos(r.yaw), math.sin(r.yaw)
+        return self.lidar.scan(
+            self.world, self.boxes, r.x + c * ox - s * oy, r.y + s * ox + c * oy, oz,
+            r.yaw + oyaw, self.obstacles,
+        )
 
     # ------------------------------------------------------------------ stepping
     def step(self) -> None:
@@ -154,6 +192,7 @@ class Simulation:
         robot = self.robot
         if command is not None:
             robot.set_command(command[0], command[1], now)
+            self.command_events.append((now, *robot.command, command[2]))
 
         if held != self._was_held:
             self._was_held = held
@@ -208,6 +247,11 @@ class Simulation:
             ranges = self.scan_now()
             for cb in self.on_scan:
                 cb(stamp, ranges)
+        if self.lidar is not None and stamp + eps >= self._next_cloud:
+            self._next_cloud = _next_due(self._next_cloud, self.lidar.period, stamp)
+            points = self.cloud_now()
+            for cb in self.on_cloud:
+                cb(stamp, points)
 
     def run_for(self, duration: float) -> None:
         """Step for ``duration`` simulated seconds (tests and offline runs)."""

@@ -1,0 +1,74 @@
+"""MppiBatch: the sampled controls, their rollouts and what the critics score them against."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from easynav.core.robot import RobotLimits
+from easynav.core.types import Costmap2D
+
+
+@dataclass(slots=True)
+class MppiBatch:
+    """One optimisation's batch, shared by every critic (arrays are ``float32``).
+
+    Controls ``vx``, ``wz`` (S×T, after the limits), the rollouts ``x``, ``y``, ``yaw`` (S×T, the
+    pose after each step of ``dt``), ``costs`` (S) that the critics add to. The local path
+    (``path_xy`` P×2, ``path_yaw`` P, ``path_s`` P arc length from the robot's projection) starts
+    at the robot's projection on the global path; ``path_is_final`` says whether it ends at the
+    goal. ``goal`` is (x, y, yaw) of the last path pose, ``goal_dist`` the robot's straight
+    distance to it. ``costmap`` is None when NavState has no ``map``.
+
+    Thread contract: built and scored in the RT thread; never shared.
+    """
+
+    vx: np.ndarray
+    wz: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    yaw: np.ndarray
+    costs: np.ndarray
+    dt: float
+    pose: tuple[float, float, float]
+    velocity: tuple[float, float]
+    limits: RobotLimits
+    path_xy: np.ndarray
+    path_yaw: np.ndarray
+    path_s: np.ndarray
+    path_is_final: bool
+    goal: tuple[float, float, float]
+    goal_dist: float
+    costmap: Costmap2D | None = None
+    _furthest: int | None = field(default=None, repr=False)
+
+    @property
+    def samples(self) -> int:
+        """Number of sampled control sequences (S)."""
+        return int(self.vx.shape[0])
+
+    @property
+    def steps(self) -> int:
+        """Number of steps of each sequence (T)."""
+        return int(self.vx.shape[1])
+
+    def furthest_reached_index(self) -> int:
+        """Index of the local-path point nearest to any rollout's end (the furthest one).
+
+        Computed once per batch (Nav2's "furthest reached path point"): the critics that look
+        ahead of it (path align, path follow, path angle) share it.
+        """
+        if self._furthest is None:
+            if len(self.path_xy) <= 1:
+                self._furthest = 0
+            else:
+                ends = np.stack((self.x[:, -1], self.y[:, -1]), axis=1)
+                path = self.path_xy.astype(np.float32)
+                d2 = (
+                    np.sum(ends * ends, axis=1)[:, None]
+                    - 2.0 * ends @ path.T
+                    + np.sum(path * path, axis=1)[None, :]
+                )
+                self._furthest = int(np.argmin(d2, axis=1).max())
+        return self._furthest

@@ -1,0 +1,206 @@
+"""SerestController (easynav_serest_controller/SerestController): safe reference tracking."""
+
+from __future__ import annotations
+
+import math
+
+from easynav.controllers.controller_keys import (
+    CLOSEST_OBSTACLE_DISTANCE,
+    GOAL_TOLERANCE_POSITION,
+    GOAL_TOLERANCE_YAW,
+    MAP,
+    SEREST_DEBUG_KEYS,
+)
+from easynav.controllers.obstacle_distance import closest_lethal_distance
+from easynav.controllers.serest_tracker import SerestTracker
+from easynav.core.nav_state import NavState
+from easynav.core.nav_state_keys import CMD_VEL, PATH, ROBOT_POSE
+from easynav.core.plugins import ControllerMethodBase, Param
+from easynav.core.robot import RobotLimits
+from easynav.core.sensors import PointPerception, PointPerceptionsOps
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import Costmap2D, Header, Odometry, Path, Twist, TwistStamped
+
+_GE0 = {"ge": 0.0}
+_GT0 = {"gt": 0.0}
+
+
+def _p(name: str, default, description: str, unit: str = "", **rules) -> Param:
+    return Param(name, default, description, unit, **rules)
+
+
+#: Deprecated per-controller limits and the robot_limits field each one stands for.
+DEPRECATED_LIMITS = {
+    "max_linear_speed": "max_linear_vel",
+    "max_angular_speed": "max_angular_vel",
+    "max_linear_acc": "max_linear_acc",
+    "max_angular_acc": "max_angular_acc",
+}
+
+
+class SerestController(ControllerMethodBase):
+    """Follows NavState ``path`` with :class:`SerestTracker`; writes ``cmd_vel``.
+
+    Limits: ``get_robot_limits()`` every cycle (speeds, accelerations; ``min_linear_vel`` when
+    ``allow_reverse``). The original's ``max_linear_speed``, ``max_angular_speed``,
+    ``max_linear_acc``, ``max_angular_acc`` are deprecated: unset by default; set, controller_node
+    applies each to its robot_limits field where the params file does not set that field.
+
+    Obstacle distance: NavState ``closest_obstacle_distance`` (float) when present; else the
+    nearest lethal cell of the Costmap2D in ``map`` within ``dist_search_radius``; else, when a
+    NavState group named ``points`` exists (as the original), the nearest ungrouped point
+    perception within the square of ``dist_search_radius`` (0.3 m voxels, z <= 2 m, robot
+    footprint frame); else none (infinite).
+
+    NavState: reads ``path``, ``robot_pose``, ``map`` (required, as in the original: absent, the
+    command is zero), ``closest_obstacle_distance``, ``goal_tolerance.position|yaw`` (preferred
+    to ``goal_pos_tol`` / ``goal_yaw_tol_deg``); writes ``cmd_vel`` (node clock stamp, robot
+    footprint frame) and the ``serest.debug.*`` values.
+
+    Thread contract: ``initialize`` in the configuring thread; ``update_rt`` in the RT thread.
+    Exceptions: :class:`PluginConfigurationError` naming the parameter.
+    """
+
+    PARAMETERS = (
+        _p("allow_reverse", False, "allow negative speeds (down to robot_limits.min_linear_vel)"),
+        _p("v_progress_min", 0.05, "accepted for compatibility; unused (as in the original)",
+           "m/s", **_GE0),
+        _p("k_s_share_max", 0.5, "cap of the lateral progress term, share of the forward term",
+           **_GE0),
+        _p("k_s", 0.8, "lateral gain of the progress rate", **_GE0),
+        _p("k_theta", 2.0, "heading error gain", **_GE0),
+        _p("k_y", 1.2, "lateral error gain (through atan(e_y / ell))", **_GE0),
+        _p("ell", 0.3, "lateral error length scale", "m", **_GT0),
+        _p("v_ref", 0.6, "reference progress speed", "m/s", **_GE0),
+        _p("eps", 1e-3, "numerical epsilon (kept for compatibility)", **_GT0),
+        _p("a_acc", 0.8, "accepted for compatibility; acceleration comes from robot_limits",
+           "m/s^2", **_GT0),
+        _p("a_brake", 1.2, "braking deceleration for the safe speed and emergencies", "m/s^2",
+           **_GT0),
+        _p("a_lat_max", 1.5, "accepted for compatibility; a_lat_soft limits the lateral "
+           "acceleration (as in the original)", "m/s^2", **_GT0),
+        _p("d0_margin", 0.30, "distance kept to the closest obstacle", "m", **_GE0),
+        _p("tau_latency", 0.10, "reaction latency of the safe speed", "s", **_GE0),
+        _p("d_hard", 0.20, "obstacle distance of an emergency brake", "m", **_GE0),
+        _p("t_emerg", 0.25, "time to the obstacle of an emergency brake", "s", **_GE0),
+        _p("blend_base", 0.6, "heading blend length at vertices", "m", **_GE0),
+        _p("blend_k_per_v", 0.6, "extra blend length per m/s", "s", **_GE0),
+        _p("kappa_max", 2.5, "cap of the blended curvature", "1/m", **_GT0),
+        _p("dist_search_radius", 2.0, "half-side of the obstacle search square", "m", **_GT0),
+        _p("goal_pos_tol", 0.05, "stop radius when goal_tolerance.position is absent", "m",
+           **_GE0),
+        _p("goal_yaw_tol_deg", 5.0, "yaw tolerance when goal_tolerance.yaw is absent", "deg",
+           **_GT0),
+        _p("slow_radius", 0.60, "radius of the slow zone around the goal", "m", **_GE0),
+        _p("slow_min_speed", 0.03, "cruise speed floor when aligned, outside the stop zone",
+           "m/s", **_GE0),
+        _p("final_align_k", 2.0, "yaw gain of the final alignment", **_GE0),
+        _p("final_align_wmax", 0.6, "turn rate cap of the final alignment", "rad/s", **_GT0),
+        _p("corner_guard_enable", True, "slow down and steer harder outside tight corners"),
+        _p("corner_gain_ey", 1.5, "corner penalty per m outside the path", **_GE0),
+        _p("corner_gain_eth", 0.7, "corner penalty per rad of heading error", **_GE0),
+        _p("corner_gain_kappa", 0.4, "corner penalty per 1/m of curvature", **_GE0),
+        _p("corner_min_alpha", 0.35, "lowest corner speed factor", ge=0.0, le=1.0),
+        _p("corner_boost_omega", 0.8, "turn rate boost when outside a corner", **_GE0),
+        _p("apex_ey_des", 0.05, "lateral offset towards the apex in corners", "m", **_GE0),
+        _p("a_lat_soft", 1.1, "lateral acceleration limit of the curvature speed", "m/s^2",
+           **_GT0),
+    ) + tuple(
+        Param(name, math.nan, f"deprecated: controller_node robot_limits.{field} (applied there "
+              "where that is not set)", ge=0.0, allow_nan=True, dynamic=False)
+        for name, field in DEPRECATED_LIMITS.items()
+    )
+    READS = (PATH, ROBOT_POSE, MAP, CLOSEST_OBSTACLE_DISTANCE, GOAL_TOLERANCE_POSITION,
+             GOAL_TOLERANCE_YAW)
+    #: The original's own limits and the robot_limits field each stands for (controller_node
+    #: applies them where robot_limits does not set that field).
+    DEPRECATED_LIMITS = DEPRECATED_LIMITS
+    WRITES = (CMD_VEL, *SEREST_DEBUG_KEYS.values())
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.tracker = SerestTracker()
+        self.state = "no_path"
+        self._last_time: float | None = None
+        self._path: Path | None = None
+        self._path_xy_yaw = None
+
+    def on_initialize(self) -> None:
+        self.tracker = SerestTracker(self.params)
+        self.state = "no_path"
+        self._last_time = None
+        self._path = None
+
+    def limits(self) -> RobotLimits:
+        """The limits in force (``get_robot_limits()``), read every cycle."""
+        return self.get_robot_limits()
+
+    def obstacle_distance(self, nav_state: NavState, x: float, y: float) -> float:
+        """The closest obstacle's distance (see the class docstring for the sources)."""
+        if nav_state.has(CLOSEST_OBSTACLE_DISTANCE):
+            value = nav_state.get(CLOSEST_OBSTACLE_DISTANCE)
+            if isinstance(value, (int, float)) and not math.isnan(value):
+                return float(value)
+        radius = self.params.dist_search_radius
+        costmap = nav_state.get(MAP)
+        if isinstance(costmap, Costmap2D):
+            return closest_lethal_distance(costmap, x, y, radius)
+        if "points" not in nav_state.groups():
+            return math.inf
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
+        points = (
+            PointPerceptionsOps(nav_state.get_no_group(PointPerception), logger=self.logger)
+            .downsample(0.3)
+            .fuse(frame)
+            .filter((-radius, -radius, math.nan), (radius, radius, 2.0))
+            .downsample(0.3)
+            .as_points()
+        )
+        if len(points) == 0:
+            return math.inf
+        return float(min(math.hypot(px, py) for px, py in points[:, :2]))
+
+    def _stop(self, nav_state: NavState, now: float, state: str) -> None:
+        self.tracker.reset()
+        self.state = state
+        self._last_time = now
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
+        nav_state.set(CMD_VEL, TwistStamped(Header(now, frame), Twist()))
+
+    def update_rt(self, nav_state: NavState) -> None:
+        """Compute and write ``cmd_vel`` and the debug values. RT thread."""
+        now = self.now()
+        path = nav_state.get(PATH, Path) if nav_state.has(PATH) else None
+        robot = nav_state.get(ROBOT_POSE, Odometry) if nav_state.has(ROBOT_POSE) else None
+        if robot is None or not robot.is_finite():
+            self._stop(nav_state, now, "no_pose")
+            return
+        if path is None or len(path) == 0 or not nav_state.has(MAP):
+            self._stop(nav_state, now, "no_path" if nav_state.has(MAP) else "no_map")
+            return
+        dt = 1.0 / self.rt_freq if self._last_time is None else now - self._last_time
+        if dt == 0.0:
+            return  # a second trigger within one clock tick: the previous command stands
+        if dt < 0.0:
+            self.tracker.reset()
+            dt = 1.0 / self.rt_freq
+        self._last_time = now
+        if path is not self._path:
+            self._path, self._path_xy_yaw = path, path.as_xy_yaw()
+        pose = (robot.pose.x, robot.pose.y, robot.pose.yaw)
+        pos_tol = nav_state.get_or(GOAL_TOLERANCE_POSITION, None)
+        yaw_tol = nav_state.get_or(GOAL_TOLERANCE_YAW, None)
+        out = self.tracker.step(
+            self._path_xy_yaw,
+            pose,
+            dt,
+            self.limits(),
+            self.obstacle_distance(nav_state, pose[0], pose[1]),
+            None if pos_tol is None else float(pos_tol),
+            None if yaw_tol is None else float(yaw_tol),
+        )
+        self.state = out.state
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
+        nav_state.set(CMD_VEL, TwistStamped(Header(now, frame), Twist(vx=out.v, wz=out.w)))
+        for name, value in out.debug.items():
+            nav_state.set(SEREST_DEBUG_KEYS[name], value)

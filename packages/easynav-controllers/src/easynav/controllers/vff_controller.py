@@ -1,0 +1,191 @@
+"""VffController (easynav_vff_controller/VffController): virtual force field navigation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from easynav.controllers.command_limits import limit_command
+from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW
+from easynav.controllers.path_follower import carrot_on_path
+from easynav.controllers.vff_vectors import VffVectors
+from easynav.core.nav_state import NavState
+from easynav.core.nav_state_keys import CMD_VEL, GOALS, PATH, ROBOT_POSE
+from easynav.core.plugins import ControllerMethodBase, Param
+from easynav.core.robot import RobotLimits
+from easynav.core.sensors import PointPerception, PointPerceptionsOps
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import Goals, Header, Odometry, Path, Twist, TwistStamped
+
+#: States reported in ``self.state``.
+FOLLOWING, ALIGNING, ARRIVED, NO_GOAL = "following", "aligning", "arrived", "no_goal"
+
+
+def _wrap(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+class VffController(ControllerMethodBase):
+    """Drives towards a target with a virtual force field; writes ``cmd_vel``.
+
+    Target: with ``follow_path`` (default) and a non-empty ``path``, the carrot
+    ``look_ahead_dist`` metres along the path beyond the robot's projection, and the path's last
+    pose as the goal; otherwise the first of ``goals`` (the original's only target). Field (see
+    :class:`VffVectors`): attraction towards the target, of length 1 scaled down within
+    ``distance_to_goal`` of the goal (approach slow-down), plus repulsion from the nearest point
+    of the ungrouped point perceptions inside the ``obstacle_detection_*`` box (robot footprint
+    frame) nearer than ``distance_obstacle_detection``. Within the goal tolerance
+    (``goal_tolerance.*``, else ``fallback_goal_*``) it stops and turns to the goal yaw, then
+    commands zero (the original never stopped by itself). Commands are kept within the limits in
+    force (``get_robot_limits()``, every cycle), speeds and accelerations.
+
+    NavState: reads ``path``, ``goals``, ``robot_pose``, ``goal_tolerance.position|yaw``,
+    ungrouped point perceptions; writes ``cmd_vel`` (node clock stamp, robot footprint frame;
+    zero without a target or a pose).
+
+    Thread contract: ``initialize`` in the configuring thread; ``update_rt`` in the RT thread.
+    Exceptions: :class:`PluginConfigurationError` naming the parameter.
+    """
+
+    PARAMETERS = (
+        Param("distance_obstacle_detection", 3.0, "range of the repulsion", "m", gt=0.0),
+        Param("distance_to_goal", 1.0, "attraction shrinks linearly within this distance of the "
+              "goal (never read by the original)", "m", gt=0.0),
+        Param("obstacle_detection_x_min", 0.5, "obstacle box, robot footprint frame", "m"),
+        Param("obstacle_detection_x_max", 10.0, "obstacle box", "m"),
+        Param("obstacle_detection_y_min", -10.0, "obstacle box", "m"),
+        Param("obstacle_detection_y_max", 10.0, "obstacle box", "m"),
+        Param("obstacle_detection_z_min", 0.10, "obstacle box", "m"),
+        Param("obstacle_detection_z_max", 1.00, "obstacle box", "m"),
+        Param("max_speed", math.nan, "deprecated: controller_node robot_limits.max_linear_vel "
+              "(applied there where that is not set)", "m/s", ge=0.0, allow_nan=True,
+              dynamic=False),
+        Param("max_angular_speed", math.nan, "deprecated: controller_node robot_limits."
+              "max_angular_vel (applied there where that is not set)", "rad/s", ge=0.0,
+              allow_nan=True, dynamic=False),
+        Param("follow_path", True, "attract to a carrot on `path` (false: to the first goal, as "
+              "the original)"),
+        Param("look_ahead_dist", 0.6, "carrot distance along the path", "m", gt=0.0),
+        Param("fallback_goal_pos_tol", 0.05, "position tolerance when goal_tolerance.position "
+              "is absent", "m", gt=0.0),
+        Param("fallback_goal_yaw_tol", 0.05, "yaw tolerance when goal_tolerance.yaw is absent",
+              "rad", gt=0.0),
+    )
+    READS = (PATH, GOALS, ROBOT_POSE, GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW)
+    WRITES = (CMD_VEL,)
+    #: The original's own limits and the robot_limits field each stands for (controller_node
+    #: applies them where robot_limits does not set that field).
+    DEPRECATED_LIMITS = {"max_speed": "max_linear_vel", "max_angular_speed": "max_angular_vel"}
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.state = NO_GOAL
+        self.vectors: VffVectors | None = None
+        self._last_time: float | None = None
+        self._last = (0.0, 0.0)
+        self._aligning = False
+
+    def on_initialize(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the previous command and the final alignment."""
+        self.state = NO_GOAL
+        self._last_time = None
+        self._last = (0.0, 0.0)
+        self._aligning = False
+
+    def limits(self) -> RobotLimits:
+        """The limits in force (``get_robot_limits()``), read every cycle."""
+        return self.get_robot_limits()
+
+    def target(self, nav_state: NavState, pose) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(carrot xy, goal xy-yaw)`` or None without a target."""
+        if self.params.follow_path and nav_state.has(PATH):
+            path = nav_state.get(PATH, Path)
+            if len(path):
+                xy_yaw = path.as_xy_yaw()
+                carrot = carrot_on_path(
+                    xy_yaw[:, :2], np.array(pose[:2]), self.params.look_ahead_dist
+                )
+                return carrot, xy_yaw[-1]
+        if nav_state.has(GOALS):
+            goals = nav_state.get(GOALS, Goals)
+            if len(goals):
+                goal = goals.goals[0].pose
+                xy_yaw = np.array((goal.x, goal.y, goal.yaw))
+                return xy_yaw[:2], xy_yaw
+        return None
+
+    def obstacle_points(self, nav_state: NavState) -> np.ndarray:
+        """The points in the detection box, ``(N, 2)`` in the robot footprint frame."""
+        p = self.params
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
+        points = (
+            PointPerceptionsOps(nav_state.get_no_group(PointPerception), logger=self.logger)
+            .filter((-10.0, -10.0, -10.0), (10.0, 10.0, 10.0))
+            .fuse(frame)
+            .filter(
+                (p.obstacle_detection_x_min, p.obstacle_detection_y_min,
+                 p.obstacle_detection_z_min),
+                (p.obstacle_detection_x_max, p.obstacle_detection_y_max,
+                 p.obstacle_detection_z_max),
+            )
+            .as_points()
+        )
+        return points[:, :2]
+
+    def _write(self, nav_state: NavState, now: float, v: float, w: float) -> None:
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
+        nav_state.set(CMD_VEL, TwistStamped(Header(now, frame), Twist(vx=v, wz=w)))
+
+    def update_rt(self, nav_state: NavState) -> None:
+        """Compute and write ``cmd_vel``. RT thread."""
+        now = self.now()
+        robot = nav_state.get(ROBOT_POSE, Odometry) if nav_state.has(ROBOT_POSE) else None
+        pose = None
+        if robot is not None and robot.is_finite():
+            pose = (robot.pose.x, robot.pose.y, robot.pose.yaw)
+        target = None if pose is None else self.target(nav_state, pose)
+        if target is None:
+            self.reset()
+            self._write(nav_state, now, 0.0, 0.0)
+            return
+        dt = 1.0 / self.rt_freq if self._last_time is None else now - self._last_time
+        if dt == 0.0:
+            return  # a second trigger within one clock tick: the previous command stands
+        if dt < 0.0:
+            self.reset()
+            dt = 1.0 / self.rt_freq
+        self._last_time = now
+        limits = self.limits()
+        carrot, goal = target
+        p = self.params
+        pos_tol = float(nav_state.get_or(GOAL_TOLERANCE_POSITION, p.fallback_goal_pos_tol))
+        yaw_tol = float(nav_state.get_or(GOAL_TOLERANCE_YAW, p.fallback_goal_yaw_tol))
+        dist = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
+        # Enter the final alignment within the tolerance; leave it only beyond twice it.
+        self._aligning = dist <= pos_tol or (self._aligning and dist <= 2.0 * pos_tol)
+        if self._aligning:
+            yaw_error = _wrap(pose[2] - goal[2])
+            if abs(yaw_error) <= yaw_tol:
+                self.state = ARRIVED
+                v, w = 0.0, 0.0
+            else:
+                self.state = ALIGNING
+                v, w = 0.0, -yaw_error
+        else:
+            self.state = FOLLOWING
+            bearing = math.atan2(carrot[1] - pose[1], carrot[0] - pose[0])
+            attraction = min(1.0, dist / self.params.distance_to_goal)
+            self.vectors = VffVectors.compute(
+                _wrap(bearing - pose[2]),
+                self.obstacle_points(nav_state),
+                self.params.distance_obstacle_detection,
+                attraction,
+            )
+            v, w = self.vectors.command(limits.max_linear_vel, limits.max_angular_vel)
+        v, w = limit_command(v, w, *self._last, dt, limits, allow_reverse=False)
+        self._last = (v, w)
+        self._write(nav_state, now, v, w)

@@ -1,0 +1,135 @@
+"""The path follower's reversing mode (allow_reversing) on a simulated unicycle."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from easynav.controllers import ARRIVED, SimplePathFollower
+from easynav.controllers.path_follower import path_segments
+from easynav.core.robot import RobotLimits
+
+LIMITS = replace(RobotLimits(), min_linear_vel=-0.3)
+
+
+def simulate(follower, path, start, limits=LIMITS, dt=1 / 30, seconds=60.0):
+    x, y, yaw = start
+    trace = []
+    for _ in range(int(seconds / dt)):
+        v, w, state = follower.compute((x, y, yaw), path, dt, limits)
+        assert limits.min_linear_vel - 1e-12 <= v <= limits.max_linear_vel + 1e-12
+        assert abs(w) <= limits.max_angular_vel + 1e-12
+        trace.append((x, y, yaw, v, w))
+        if state == ARRIVED:
+            return np.array(trace), True
+        x += v * math.cos(yaw) * dt
+        y += v * math.sin(yaw) * dt
+        yaw += w * dt
+    return np.array(trace), False
+
+
+def straight(x0, x1, step=0.05, yaw=0.0):
+    xs = np.arange(x0, x1, step if x1 > x0 else -step)
+    return np.array([(x, 0.0, yaw) for x in list(xs) + [x1]])
+
+
+def forward_then_reverse_arc() -> np.ndarray:
+    """Forward 1.5 m along x (yaw 0), then reverse along a left-hand arc of radius 1 m (the
+    car backs up turning its rear to +y): a Reeds–Shepp-like path with one cusp."""
+    forward = straight(0.0, 1.5)
+    t = np.linspace(0.0, math.pi / 2, 40)[1:]
+    # Centre (1.5, 1.0); the car backs along the circle, heading = tangent + pi.
+    cx, cy, r = 1.5, 1.0, 1.0
+    phi = -math.pi / 2 - t  # from the bottom of the circle, clockwise = backwards
+    arc = np.stack([cx + r * np.cos(phi), cy + r * np.sin(phi), -t], axis=1)
+    return np.concatenate([forward, arc])
+
+
+def test_segments_are_cut_at_cusps():
+    path = forward_then_reverse_arc()
+    cusp = len(straight(0.0, 1.5)) - 1
+    assert path_segments(path) == [(0, cusp, 1), (cusp, len(path) - 1, -1)]
+    assert path_segments(straight(0.0, 1.0)) == [(0, 20, 1)]
+    assert path_segments(straight(1.0, 0.0)) == [(0, 20, -1)]
+    assert path_segments(np.array([[1.0, 2.0, 0.0]])) == [(0, 0, 1)]
+    # A repeated pose keeps the direction of the step before it.
+    doubled = np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0]])
+    assert path_segments(doubled) == [(0, 3, 1)]
+
+
+def test_a_goal_behind_is_reached_backing_up_without_turning_around():
+    follower = SimplePathFollower(look_ahead_dist=0.3, allow_reversing=True)
+    trace, arrived = simulate(follower, straight(1.0, 0.0), (1.0, 0.02, 0.0))
+    assert arrived
+    assert (trace[:, 3] <= 1e-12).all() and trace[:, 3].min() < -0.2
+    assert np.abs(trace[:, 2]).max() < 0.3  # never turned around
+    assert math.hypot(trace[-1, 0], trace[-1, 1]) <= 0.05
+
+
+def test_without_the_parameter_the_robot_never_reverses():
+    follower = SimplePathFollower(look_ahead_dist=0.3)
+    trace, arrived = simulate(follower, straight(1.0, 0.0), (1.0, 0.02, 0.0))
+    assert arrived and (trace[:, 3] >= 0.0).all()
+    assert np.abs(trace[:, 2]).max() > 2.5  # it turned around instead
+
+
+def test_a_path_with_a_cusp_is_driven_forward_then_in_reverse():
+    path = forward_then_reverse_arc()
+    follower = SimplePathFollower(look_ahead_dist=0.3, allow_reversing=True)
+    trace, arrived = simulate(follower, path, (0.0, 0.0, 0.0))
+    assert arrived
+    v = trace[:, 3]
+    first_reverse = int(np.argmax(v < -1e-9))
+    assert (v[:first_reverse] >= 0.0).all() and (v[first_reverse:] <= 1e-12).all()
+    # It went to the cusp before reversing.
+    assert math.hypot(trace[first_reverse, 0] - 1.5, trace[first_reverse, 1]) <= 0.1 + 0.02
+    # It stayed near the path all along and ended on the goal with its yaw.
+    d = np.hypot(trace[:, None, 0] - path[None, :, 0], trace[:, None, 1] - path[None, :, 1])
+    assert d.min(axis=1).max() < 0.15
+    assert math.hypot(trace[-1, 0] - path[-1, 0], trace[-1, 1] - path[-1, 1]) <= 0.05
+    assert abs(math.remainder(trace[-1, 2] - path[-1, 2], math.tau)) <= 0.1
+
+
+def test_a_robot_that_cannot_reverse_drives_every_segment_forward():
+    follower = SimplePathFollower(look_ahead_dist=0.3, allow_reversing=True)
+    no_reverse = replace(LIMITS, min_linear_vel=0.0)
+    trace, arrived = simulate(follower, straight(1.0, 0.0), (1.0, 0.02, 0.0), limits=no_reverse)
+    assert arrived and (trace[:, 3] >= 0.0).all()
+
+
+def test_a_new_path_starts_again_from_its_first_segment():
+    follower = SimplePathFollower(look_ahead_dist=0.3, allow_reversing=True)
+    path = forward_then_reverse_arc()
+    follower.compute((1.5, 0.0, 0.0), path, 0.1, LIMITS)  # at the cusp: second segment
+    assert follower._segment == 1
+    follower.compute((1.5, 0.0, 0.0), path.copy(), 0.1, LIMITS)  # same path, new array
+    assert follower._segment == 1
+    follower.compute((0.0, 0.0, 0.0), straight(0.0, 1.0), 0.1, LIMITS)
+    assert follower._segment == 0
+
+
+def test_cusp_tolerance_is_checked():
+    with pytest.raises(ValueError, match="cusp_tolerance = -1"):
+        SimplePathFollower(cusp_tolerance=-1.0)
+
+
+def test_the_simple_controller_passes_the_parameters_to_its_follower():
+    from easynav.controllers.simple_controller import SimpleController
+    from easynav.core.plugins import DictParameters, PluginContext
+
+    def make(values):
+        controller = SimpleController()
+        controller.initialize(
+            PluginContext(parameters=DictParameters(values), namespace="reversing_test"),
+            "simple",
+        )
+        return controller
+
+    assert not make({}).follower.allow_reversing
+    controller = make({"simple.allow_reversing": True, "simple.cusp_tolerance": 0.2})
+    assert controller.follower.allow_reversing and controller.follower.cusp_tolerance == 0.2
+    controller.apply_parameter("allow_reversing", False)
+    assert not controller.follower.allow_reversing

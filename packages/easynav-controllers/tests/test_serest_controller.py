@@ -1,0 +1,194 @@
+"""SerestController without ROS: tracking, goal zone, safety speed, limits, NavState I/O."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from closed_loop import (
+    Clock,
+    Limits,
+    assert_within_limits,
+    curved_path,
+    distance_to_path,
+    make_plugin,
+    run_closed_loop,
+    set_path,
+    set_pose,
+    straight_path,
+)
+
+from easynav.controllers.obstacle_distance import closest_lethal_distance
+from easynav.controllers.serest_controller import SerestController
+from easynav.controllers.serest_tracker import SEREST_DEFAULTS, SerestTracker
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import PluginConfigurationError
+from easynav.core.robot import RobotLimits
+from easynav.core.sensors import PointPerception
+from easynav.core.types import LETHAL_OBSTACLE, Costmap2D, TwistStamped
+
+LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0)
+DT = 0.05
+
+
+def s_path() -> np.ndarray:
+    xs = np.arange(0.0, 3.001, 0.05)
+    path = np.column_stack((xs, 0.5 * np.sin(1.5 * xs), np.zeros_like(xs)))
+    path[-1, 2] = -math.pi / 2  # a goal yaw far from the last segment's heading
+    return path
+
+
+def make(params=None, limits=LIMITS, clock=None):
+    return make_plugin(SerestController, "serest", params, limits, clock)
+
+
+def loop_state(path, free=True):
+    nav_state = NavState()
+    set_path(nav_state, path)
+    nav_state.set("map", Costmap2D.filled(200, 200, 0.05, -5.0, -5.0))
+    return nav_state
+
+
+def test_safe_speed_and_curvature_formulas():
+    tracker = SerestTracker()
+    p = SEREST_DEFAULTS
+    d = 1.0
+    expected = math.sqrt(2 * p["a_brake"] * (d - p["d0_margin"])) - p["tau_latency"] * p["a_brake"]
+    assert tracker.v_safe(d) == pytest.approx(expected)
+    assert tracker.v_safe(0.2) == 0.0 and tracker.v_safe(math.inf) == math.inf
+
+
+def test_projection_and_frenet_errors():
+    tracker = SerestTracker()
+    path = straight_path()
+    out = tracker.step(path, (1.0, 0.2, 0.1), DT, LIMITS, pos_tol=0.05, yaw_tol=0.05)
+    assert out.debug["e_y"] == pytest.approx(0.2)
+    assert out.debug["e_theta"] == pytest.approx(0.1)
+    assert out.debug["dist_to_end"] == pytest.approx(2.0)
+    assert out.w < 0.0  # left of the path and heading left: turn right
+
+
+@pytest.mark.parametrize(
+    ("make_path", "deviation"), [(straight_path, 0.05), (curved_path, 0.1), (s_path, 0.2)]
+)
+def test_follows_the_path_and_stops_at_the_goal(make_path, deviation):
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    path = make_path()
+    nav_state = loop_state(path)
+    nav_state.set("goal_tolerance.position", 0.08)
+    nav_state.set("goal_tolerance.yaw", 0.05)
+    run = run_closed_loop(serest, nav_state, clock, dt=DT, t_max=60.0)
+    assert run.arrived
+    x, y, yaw = run.final
+    assert math.hypot(x - path[-1, 0], y - path[-1, 1]) <= 0.08
+    assert abs(math.remainder(yaw - path[-1, 2], 2 * math.pi)) <= 0.05
+    assert max(distance_to_path(path, px, py) for px, py, _ in run.poses) <= deviation
+    assert_within_limits(run, LIMITS, DT, allow_reverse=False)
+    assert nav_state.get("serest.debug.goal.arrived") == 1
+
+
+def test_slows_for_an_obstacle_in_the_costmap_and_brakes_in_an_emergency():
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    path = straight_path()
+    nav_state = loop_state(path)
+    costmap = nav_state.get("map")
+    ix, iy = costmap.world_to_cell(1.0, 0.0)
+    costmap.data[iy, ix] = LETHAL_OBSTACLE
+    # Cell [1.0, 1.05] x [0, 0.05]: centre (1.025, 0.025), minus half a cell.
+    near = math.hypot(1.025, 0.025) - 0.025
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 2.0) == pytest.approx(near)
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 0.9) == math.inf
+    run = run_closed_loop(serest, nav_state, clock, dt=DT, t_max=10.0)
+    xs = [x for x, _, _ in run.poses]
+    # v_safe reaches 0 at d0_margin (0.3 m) from the cell's near edge (1.0 m): x <= 0.7.
+    assert 0.5 < max(xs) <= 0.7 + 1e-6
+    assert run.commands[-1][0] < 0.01  # creeping to a stop
+    assert nav_state.get("serest.debug.d_closest") < 0.4
+
+
+def test_closest_obstacle_distance_key_overrides_the_map():
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    nav_state = loop_state(straight_path())
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    nav_state.set("closest_obstacle_distance", 0.1)
+    serest.update_rt(nav_state)
+    assert serest.state == "emergency"
+    assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero()
+
+
+def test_without_map_the_command_is_zero():
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    nav_state = NavState()
+    set_path(nav_state, straight_path())
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    serest.update_rt(nav_state)
+    assert serest.state == "no_map"
+    assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero()
+
+
+def test_runtime_limit_and_parameter_changes_take_effect_at_once():
+    clock = Clock()
+    limits = Limits(LIMITS)
+    serest = make({}, limits, clock)
+    nav_state = loop_state(straight_path())
+    run = run_closed_loop(serest, nav_state, clock, dt=DT, t_max=3.0)
+    assert max(v for v, _ in run.commands) > 0.45
+    limits.value = RobotLimits(max_linear_vel=0.15, max_angular_vel=0.5)
+    serest.apply_parameter("v_ref", 0.1)
+    run = run_closed_loop(serest, nav_state, clock, start=run.final, dt=DT, t_max=1.0)
+    speeds = [v for v, _ in run.commands]
+    assert max(speeds) <= 0.15 + 1e-9  # the new limit from the first command on
+    assert np.mean(speeds[-5:]) <= 0.11  # and the new reference speed
+
+
+def test_deprecated_limits_are_left_to_controller_node():
+    serest = make({"max_linear_speed": 0.3, "max_angular_acc": 0.5})
+    assert serest.params.max_linear_speed == 0.3 and serest.params.max_angular_acc == 0.5
+    assert SerestController.DEPRECATED_LIMITS["max_angular_acc"] == "max_angular_acc"
+    assert serest.limits() == LIMITS
+
+
+def test_turns_in_place_when_facing_away_from_the_path():
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    nav_state = loop_state(straight_path())
+    set_pose(nav_state, 0.0, 0.0, 2.0)
+    serest.update_rt(nav_state)
+    cmd = nav_state.get("cmd_vel", TwistStamped).twist
+    assert serest.state == "turn_in_place" and cmd.vx == 0.0 and cmd.wz < 0.0
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ({"ell": 0.0}, "serest.ell = 0.0: must be > 0"),
+        ({"allow_reverse": "yes"}, "serest.allow_reverse = 'yes': must be true or false"),
+        ({"corner_min_alpha": 2.0}, "serest.corner_min_alpha = 2.0"),
+    ],
+)
+def test_bad_parameters_fail_configuration(params, message):
+    with pytest.raises(PluginConfigurationError, match=message):
+        make(params)
+
+
+def test_point_perceptions_count_only_when_a_points_group_exists():
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    nav_state = NavState()
+    set_path(nav_state, straight_path())
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    nav_state.set("map", "a map of any other type")  # required, but not a Costmap2D
+    scan = np.array([[0.8, 0.6, 0.2], [3.0, 0.0, 0.2]])
+    nav_state.set("scan", PointPerception(scan, "base_footprint", clock.t))
+    serest.update_rt(nav_state)
+    assert nav_state.get("serest.debug.d_closest") == math.inf
+    nav_state.set_group("points", ["a_grouped_sensor"])
+    clock.t += DT
+    serest.update_rt(nav_state)
+    # 0.3 m voxels: the point (0.8, 0.6) stays the first of its voxel; (3, 0) is out of range.
+    assert nav_state.get("serest.debug.d_closest") == pytest.approx(1.0)

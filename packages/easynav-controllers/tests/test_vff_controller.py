@@ -1,0 +1,137 @@
+"""VffController without ROS: the field, closed loops on paths and goals, a wall, limits."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from closed_loop import (
+    Clock,
+    Limits,
+    assert_within_limits,
+    curved_path,
+    distance_to_path,
+    make_plugin,
+    run_closed_loop,
+    set_path,
+    set_pose,
+    straight_path,
+)
+
+from easynav.controllers.vff_controller import VffController
+from easynav.controllers.vff_vectors import VffVectors
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import PluginConfigurationError
+from easynav.core.robot import RobotLimits
+from easynav.core.sensors import PointPerception
+from easynav.core.types import Goals, Header, Pose, PoseStamped, TwistStamped
+
+LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0)
+DT = 0.05
+
+
+def test_field_matches_the_original():
+    # Goal 30 degrees left, nearest point 1 m ahead-right: repulsion of length 3 - 1 = 2 away.
+    points = np.array([[0.8, -0.6], [3.0, 2.0]])
+    vff = VffVectors.compute(math.radians(30), points, 3.0)
+    assert vff.attractive == pytest.approx((math.cos(math.radians(30)), 0.5))
+    assert vff.repulsive == pytest.approx((-1.6, 1.2))
+    assert vff.result == pytest.approx((math.cos(math.radians(30)) - 1.6, 1.7))
+    assert VffVectors.compute(0.0, points, 0.9).repulsive == (0.0, 0.0)  # out of range
+    v, w = VffVectors.compute(0.0, np.empty((0, 2)), 3.0).command(0.8, 1.5)
+    assert (v, w) == (0.8, 0.0)
+    v, w = vff.command(0.8, 1.5)
+    assert v == 0.0 and w == 1.5  # the result points backwards-left: turn first
+
+
+@pytest.mark.parametrize(("make_path", "deviation"), [(straight_path, 0.05), (curved_path, 0.2)])
+def test_follows_the_path_and_stops_at_the_goal(make_path, deviation):
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", {}, LIMITS, clock)
+    nav_state = NavState()
+    path = make_path()
+    set_path(nav_state, path)
+    nav_state.set("goal_tolerance.position", 0.1)
+    nav_state.set("goal_tolerance.yaw", 0.1)
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0)
+    assert run.arrived
+    x, y, yaw = run.final
+    assert math.hypot(x - path[-1, 0], y - path[-1, 1]) <= 0.1
+    assert abs(math.remainder(yaw - path[-1, 2], 2 * math.pi)) <= 0.1
+    assert max(distance_to_path(path, px, py) for px, py, _ in run.poses) <= deviation
+    assert_within_limits(run, LIMITS, DT, allow_reverse=False)
+
+
+def test_goes_to_the_first_goal_without_a_path():
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", {"follow_path": False}, LIMITS, clock)
+    nav_state = NavState()
+    goal = PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(2.0, 1.0, 1.0))
+    nav_state.set("goals", Goals(Header(0.0, "map"), [goal]))
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0)
+    assert run.arrived
+    x, y, yaw = run.final
+    assert math.hypot(x - 2.0, y - 1.0) <= 0.05 and abs(yaw - 1.0) <= 0.05
+    assert_within_limits(run, LIMITS, DT, allow_reverse=False)
+
+
+def wall_points() -> np.ndarray:
+    """A wall across x = 2 from y = 0.1 up to y = 2 (the path passes 0.1 m from its end)."""
+    ys = np.arange(0.1, 2.0, 0.05)
+    return np.column_stack((np.full_like(ys, 2.0), ys))
+
+
+def test_avoids_a_wall_next_to_the_path():
+    clock = Clock()
+    # The original's 3 m range pushes away from the whole 2 m wall for good (a local minimum):
+    # 1.5 m, counting points from the robot's centre forwards, as in the playground's params.
+    params = {"distance_obstacle_detection": 1.5, "obstacle_detection_x_min": 0.0}
+    vff = make_plugin(VffController, "vff", params, LIMITS, clock)
+    nav_state = NavState()
+    path = straight_path() * np.array([4.0 / 3.0, 1.0, 1.0])
+    set_path(nav_state, path)
+    wall = wall_points()
+
+    def scan(nav, pose):
+        x, y, yaw = pose
+        rel = wall - (x, y)
+        c, s = math.cos(yaw), math.sin(yaw)
+        local = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
+        points = np.column_stack((local, np.full(len(local), 0.3)))
+        nav.set("scan", PointPerception(points, "base_footprint", clock.t))
+
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
+    assert run.arrived
+    clearance = min(np.min(np.hypot(wall[:, 0] - x, wall[:, 1] - y)) for x, y, _ in run.poses)
+    assert clearance >= 0.4  # the path itself passes 0.1 m from the wall's end
+    assert_within_limits(run, LIMITS, DT, allow_reverse=False)
+
+
+def test_a_runtime_change_of_the_limits_takes_effect_at_once():
+    clock = Clock()
+    limits = Limits(LIMITS)
+    vff = make_plugin(VffController, "vff", {}, limits, clock)
+    nav_state = NavState()
+    set_path(nav_state, straight_path())
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=2.0)
+    assert max(v for v, _ in run.commands) > 0.45
+    limits.value = RobotLimits(max_linear_vel=0.1)
+    run = run_closed_loop(vff, nav_state, clock, start=run.final, dt=DT, t_max=1.0)
+    assert max(v for v, _ in run.commands) <= 0.1
+
+
+def test_zero_command_without_target_and_deprecated_limits():
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", {"max_speed": 0.2}, LIMITS, clock)
+    assert vff.params.max_speed == 0.2 and vff.limits() == LIMITS
+    assert VffController.DEPRECATED_LIMITS["max_speed"] == "max_linear_vel"
+    nav_state = NavState()
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    vff.update_rt(nav_state)
+    assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero() and vff.state == "no_goal"
+
+
+def test_bad_parameters_fail_configuration():
+    with pytest.raises(PluginConfigurationError, match="vff.distance_obstacle_detection = 0.0"):
+        make_plugin(VffController, "vff", {"distance_obstacle_detection": 0.0}, LIMITS)

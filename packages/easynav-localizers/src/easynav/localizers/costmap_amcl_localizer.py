@@ -1,0 +1,425 @@
+"""CostmapAMCLLocalizer (easynav_costmap_localizer/AMCLLocalizer): AMCL on a Costmap2D."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from easynav.core.nav_state import NavState
+from easynav.core.nav_state_keys import ROBOT_POSE, NavStateKey
+from easynav.core.plugins import Param, PluginConfigurationError, Topic
+from easynav.core.sensors import PointPerception, PointPerceptionsOps
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import Costmap2D, Header, Odometry, Pose
+from easynav.localizers.amcl_localizer import MIN_POINT_Z, AMCLLocalizer
+from easynav.localizers.costmap_sampling import (
+    beam_likelihood_field,
+    kld_particle_count,
+    sample_free_space,
+)
+from easynav.localizers.particle_filter import ParticleFilter2D, hit_fractions, likelihood_field
+from easynav.maps.costmap.keys import MAP_BASE
+
+#: Set it to True to ask for a global localisation (the localizer sets it back to False).
+GLOBAL_LOCALIZATION_REQUEST = NavStateKey(
+    "localizer.reinitialize_global_localization",
+    "bool",
+    "True asks the costmap AMCL to spread its particles over the free space (it resets it).",
+)
+COVARIANCE_TRACE = NavStateKey(
+    "localizer.amcl.covariance_trace", "float", "var x + var y + var yaw of the particles."
+)
+HIT_COUNT = "hit_count"
+LIKELIHOOD_FIELD = "likelihood_field"
+
+
+class CostmapAMCLLocalizer(AMCLLocalizer):
+    """Monte Carlo localisation on NavState ``map.base`` (a :class:`Costmap2D`).
+
+    The odometry, prediction (RT), ``robot_pose``, ``map → odom``, ``initialpose`` and the
+    particle topics are the simple AMCL's (:class:`AMCLLocalizer`, shared code); this class adds
+    the costmap, the original's parameters (CATALOGUE.md §2.5) and:
+
+    - ``sensor_model``: ``hit_count`` (the original: the fraction of the scan points that land on
+      lethal (254) cells, hits and possible points accumulated across corrections until the next
+      reseed, weight = hits / possible) or ``likelihood_field`` (Nav2's: each point scores
+      ``pz = z_hit·exp(-d²/2σ²) + z_rand/laser_max_range`` with ``d`` the distance to the nearest
+      lethal cell from an OpenCV distance transform, the weight is multiplied by ``1 + Σ pz³``,
+      the cloud is resampled when its effective size falls below half). Both score every
+      particle at once (:func:`hit_fractions`, vectorised over particles × points).
+    - KLD-adaptive particle count (``kld_sampling``): at each resample (each reseed in the
+      hit-count model, which does not resample otherwise) the cloud is resized to Fox's bound
+      for ``pf_err``/``pf_z`` within ``[min_particles, max_particles]``.
+    - Global localisation: particles uniform over the free cells of ``map.base``
+      (``max_particles`` of them with KLD, else ``num_particles``), on request: the service
+      ``reinitialize_global_localization`` (std_srvs/Empty, as Nav2's), the parameter
+      ``global_localization`` (true at configure or set true at runtime), or NavState
+      ``localizer.reinitialize_global_localization`` = True.
+    - Kidnapped-robot recovery (augmented MCL, Nav2's ``recovery_alpha_slow/fast``): when the
+      short-term average score falls below the long-term one, that share of particles is
+      redrawn over the free space at the next resample/reseed.
+
+    Every ``1/reseed_freq`` s the worse half is redrawn around the better half (the original's
+    reseed, :meth:`ParticleFilter2D.reseed_worst_half`). With ``compute_odom_from_tf`` the
+    odometry is ``odom → robot_footprint`` from TF instead of the ``odom`` topic.
+
+    NavState: reads ``map.base``, the ungrouped point perceptions (points above z 0.1 m in the
+    footprint frame), ``localizer.reinitialize_global_localization``; writes ``robot_pose``
+    (map frame, covariance of the particles) and ``localizer.amcl.covariance_trace``.
+
+    Thread contract: as :class:`AMCLLocalizer`; the service callback and runtime parameter
+    changes only raise a flag that ``update`` (non-RT) acts on.
+    Exceptions: configure fails naming a bad parameter; updates warn (throttled) and return.
+    """
+
+    PARAMETERS = (
+        Param("num_particles", 100, "particle count (initial count with kld_sampling)", ge=1),
+        Param("initial_pose.x", 0.0, "initial cloud mean x", "m"),
+        Param("initial_pose.y", 0.0, "initial cloud mean y", "m"),
+        Param("initial_pose.yaw", 0.0, "initial cloud mean yaw", "rad"),
+        Param("initial_pose.std_dev_xy", 0.5, "initial spread in x and y", "m", gt=0.0),
+        Param("initial_pose.std_dev_yaw", 0.5, "initial spread in yaw", "rad", gt=0.0),
+        Param("reseed_freq", 1.0, "redraw the worse half this often", "Hz", gt=0.0),
+        Param("noise_translation", 0.01, "predict σ per metre along each axis", gt=0.0),
+        Param("noise_rotation", 0.01, "predict yaw σ per radian turned", gt=0.0),
+        Param("noise_translation_to_rotation", 0.01, "predict yaw σ per metre", gt=0.0),
+        Param("min_noise_xy", 0.05, "σ floor of reseeds and initial poses", "m", gt=0.0),
+        Param("min_noise_yaw", 0.05, "σ floor of reseeds and initial poses", "rad", gt=0.0),
+        Param("compute_odom_from_tf", False, "odometry from TF odom -> footprint, not 'odom'",
+              dynamic=False),
+        Param("sensor_model", HIT_COUNT, "hit_count (original) or likelihood_field (Nav2)",
+              choices=(HIT_COUNT, LIKELIHOOD_FIELD)),
+        Param("sigma_hit", 0.2, "likelihood_field: σ of a point's distance to an obstacle", "m",
+              gt=0.0),
+        Param("z_hit", 0.5, "likelihood_field: weight of the hit term", ge=0.0),
+        Param("z_rand", 0.5, "likelihood_field: weight of the random term", ge=0.0),
+        Param("laser_max_range", 10.0, "likelihood_field: range of the random term", "m", gt=0.0),
+        Param("laser_likelihood_max_dist", 2.0, "likelihood_field: distances capped here", "m",
+              gt=0.0),
+        Param("kld_sampling", False, "adapt the particle count (KLD) at each resample"),
+        Param("min_particles", 100, "KLD lower bound", ge=1),
+        Param("max_particles", 5000, "KLD upper bound and global localisation count", ge=1),
+        Param("pf_err", 0.01, "KLD: maximum error between true and estimated distribution",
+              gt=0.0),
+        Param("pf_z", 0.99, "KLD: upper standard normal quantile (used as Nav2 does)", gt=0.0),
+        Param("recovery_alpha_slow", 0.0, "long-term score average rate (0: no recovery)",
+              ge=0.0, le=1.0),
+        Param("recovery_alpha_fast", 0.0, "short-term score average rate (0: no recovery)",
+              ge=0.0, le=1.0),
+        Param("global_localization", False, "spread the particles over the free space (at "
+              "configure, or when set true at runtime)"),
+    )
+    TOPICS = (
+        Topic("odom", "nav_msgs/msg/Odometry", "sub"),
+        Topic("initialpose", "geometry_msgs/msg/PoseWithCovarianceStamped", "sub"),
+        Topic("particles", "geometry_msgs/msg/PoseArray", "pub"),
+        Topic("pose", "geometry_msgs/msg/PoseWithCovarianceStamped", "pub"),
+    )
+    READS = (MAP_BASE, GLOBAL_LOCALIZATION_REQUEST)
+    WRITES = (ROBOT_POSE, COVARIANCE_TRACE)
+    NEEDS_MAPS = ("costmap",)
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._service = None
+        self._global_requested = False
+        self._lf_map: Costmap2D | None = None
+        self._lf_field: np.ndarray | None = None
+        self._lf_off = 0.0
+        self._hits = np.zeros(0)
+        self._possible = np.zeros(0)
+        self._acc_generation = -1
+        self._w_slow = 0.0
+        self._w_fast = 0.0
+
+    # -- configuration ------------------------------------------------------------------------
+    def on_initialize(self) -> None:
+        self._destroy_ros()
+        p = self.params
+        alias = self.plugin_name
+        if p.kld_sampling and p.min_particles > p.max_particles:
+            raise PluginConfigurationError(
+                f"{alias}.min_particles = {p.min_particles} exceeds {alias}.max_particles = "
+                f"{p.max_particles}"
+            )
+        self.num_particles = int(p.num_particles)
+        self.noise = (p.noise_translation, p.noise_rotation, p.noise_translation_to_rotation)
+        self.min_noise_xy, self.min_noise_yaw = p.min_noise_xy, p.min_noise_yaw
+        self._field_map = self._field = None
+        self._lf_map = self._lf_field = None
+        self._w_slow = self._w_fast = 0.0
+        with self._lock:
+            self._generation += 1
+            self.filter = ParticleFilter2D(self.num_particles)
+            self.filter.seed(
+                p["initial_pose.x"],
+                p["initial_pose.y"],
+                p["initial_pose.yaw"],
+                np.eye(2) * p["initial_pose.std_dev_xy"] ** 2,
+                p["initial_pose.std_dev_yaw"],
+            )
+            self._odom = self._odom_used = self._odom_used_stamp = None
+        self._global_requested = bool(p.global_localization)
+        self._last_reseed = self.now()
+        self.logger.info(
+            f"{alias}: {self.num_particles} particles around ({p['initial_pose.x']:g}, "
+            f"{p['initial_pose.y']:g}, {p['initial_pose.yaw']:g}), sensor model "
+            f"{p.sensor_model}" + (", global localisation requested" if self._global_requested
+                                   else "")
+        )
+        if self.context.node is not None:
+            self._create_ros()
+
+    @property
+    def reseed_period(self) -> float:
+        """Seconds between reseeds (``1 / reseed_freq``, read every cycle)."""
+        return 1.0 / self.params.reseed_freq
+
+    def on_parameter_changed(self, name: str, value) -> None:
+        if name in ("noise_translation", "noise_rotation", "noise_translation_to_rotation"):
+            p = self.params
+            self.noise = (p.noise_translation, p.noise_rotation, p.noise_translation_to_rotation)
+        elif name in ("min_noise_xy", "min_noise_yaw"):
+            p = self.params
+            self.min_noise_xy, self.min_noise_yaw = p.min_noise_xy, p.min_noise_yaw
+        elif name == "global_localization" and value:
+            self.request_global_localization()
+        elif name in ("sigma_hit", "z_hit", "z_rand", "laser_max_range",
+                      "laser_likelihood_max_dist"):
+            self._lf_map = None  # rebuild the likelihood table
+
+    def request_global_localization(self) -> None:
+        """Spread the particles over the free space at the next correction. Any thread."""
+        self._global_requested = True
+
+    # -- prediction (RT) ----------------------------------------------------------------------
+    def update_rt(self, nav_state: NavState) -> None:
+        """Take the TF odometry when configured so, then the shared prediction. RT thread."""
+        if self.params.compute_odom_from_tf:
+            self._odometry_from_tf()
+        super().update_rt(nav_state)
+
+    def _odometry_from_tf(self) -> None:
+        buffer = get_tf_buffer(self.context.namespace)
+        info = buffer.get_tf_info()
+        try:
+            stamp, (tx, ty, _, qx, qy, qz, qw) = buffer.lookup_transform_values(
+                info.odom_frame, info.robot_footprint_frame
+            )
+        except Exception as exc:  # noqa: BLE001 - any lookup failure: wait for the tree
+            self._throttle.warn(
+                self.logger, "tf-odom", f"{self.plugin_name}: no {info.odom_frame} -> "
+                f"{info.robot_footprint_frame} transform yet ({exc})"
+            )
+            return
+        yaw = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+        self._odom = Odometry(
+            Header(stamp, info.odom_frame), info.robot_footprint_frame,
+            Pose.from_xy_yaw(tx, ty, yaw),
+        )
+
+    # -- correction (non-RT) ------------------------------------------------------------------
+    def update(self, nav_state: NavState) -> None:
+        """Global localisation if asked; weigh the particles; resample/reseed; write the pose.
+        Non-RT thread."""
+        alias = self.plugin_name
+        if not nav_state.has(MAP_BASE):
+            self._throttle.warn(self.logger, "no-map", f"{alias}: no '{MAP_BASE}' costmap yet")
+            return
+        base = nav_state.get(MAP_BASE, Costmap2D)
+        if base.width == 0 or base.height == 0:
+            self._throttle.warn(self.logger, "empty-map", f"{alias}: '{MAP_BASE}' is empty")
+            return
+        if nav_state.has(GLOBAL_LOCALIZATION_REQUEST) and nav_state.get(
+            GLOBAL_LOCALIZATION_REQUEST
+        ):
+            nav_state.set(GLOBAL_LOCALIZATION_REQUEST, False)
+            self._global_requested = True
+        if self._global_requested:
+            self._global_requested = False
+            self._spread_globally(base)
+        points = self._scan_points(nav_state, base.resolution)
+        if points is None:
+            return
+        with self._lock:
+            snapshot = self.filter.poses.copy()
+            generation = self._generation
+        if self.params.sensor_model == LIKELIHOOD_FIELD:
+            weights, score = self._likelihood_field_weights(snapshot, points, base)
+        else:
+            weights, score = self._hit_count_weights(snapshot, points, base, generation)
+        self._track_scores(score)
+        now = self.now()
+        with self._lock:
+            if generation == self._generation:  # not redrawn (initialpose) while scoring
+                self._apply(weights, base)
+            if now - self._last_reseed >= self.reseed_period or now < self._last_reseed:
+                self._reseed(base)
+                self._last_reseed = now
+            estimate = self.filter.estimate()
+            covariance = self.filter.covariance(estimate)
+            poses = self.filter.poses.copy()
+        self._write_pose(nav_state, estimate, covariance, self._odom)
+        self._publish_particles(poses, estimate, covariance)
+
+    def _scan_points(self, nav_state: NavState, resolution: float) -> np.ndarray | None:
+        perceptions = nav_state.get_no_group(PointPerception)
+        if not perceptions:
+            self._throttle.warn(self.logger, "no-perceptions",
+                                f"{self.plugin_name}: no point perceptions")
+            return None
+        buffer = get_tf_buffer(self.context.namespace)
+        frame = buffer.get_tf_info().robot_footprint_frame
+        points = (
+            PointPerceptionsOps(perceptions, buffer, self.logger)
+            .fuse(frame)
+            .filter((math.nan, math.nan, MIN_POINT_Z), (math.nan, math.nan, math.nan))
+            .collapse((math.nan, math.nan, 0.0))
+            .downsample(resolution)
+            .as_points()
+        )
+        if len(points) == 0:
+            self._throttle.warn(
+                self.logger, "no-points",
+                f"{self.plugin_name}: no points to correct with (none above z {MIN_POINT_Z} m "
+                f"in {frame})",
+            )
+            return None
+        return points[:, :2]
+
+    def _hit_count_weights(self, poses, points, base, generation) -> tuple[np.ndarray, float]:
+        """The original's model: hits on lethal cells / possible (in-map) points, accumulated
+        since the last reseed."""
+        if base is not self._field_map:  # map.base is replaced, never mutated: cache per object
+            self._field, self._field_map = likelihood_field(base, 0.0), base
+        fractions, possible = hit_fractions(poses, points, base, self._field)
+        if self._acc_generation != generation or len(self._hits) != len(poses):
+            self._hits = np.zeros(len(poses))
+            self._possible = np.zeros(len(poses))
+            self._acc_generation = generation
+        self._hits += fractions * possible
+        self._possible += possible
+        weights = np.divide(self._hits, self._possible, out=np.zeros(len(poses)),
+                            where=self._possible > 0)
+        return weights, float(fractions.mean())
+
+    def _likelihood_field_weights(self, poses, points, base) -> tuple[np.ndarray, float]:
+        p = self.params
+        if base is not self._lf_map:
+            self._lf_field, self._lf_off = beam_likelihood_field(
+                base, p.sigma_hit, p.z_hit, p.z_rand, p.laser_max_range,
+                p.laser_likelihood_max_dist,
+            )
+            self._lf_map = base
+        mean, inside = hit_fractions(poses, points, base, self._lf_field)
+        total = mean * inside + (len(points) - inside) * self._lf_off
+        return 1.0 + total, float((total / len(points)).mean())
+
+    def _track_scores(self, score: float) -> None:
+        p = self.params
+        if p.recovery_alpha_slow <= 0.0 or p.recovery_alpha_fast <= 0.0:
+            return
+        if self._w_slow == 0.0:
+            self._w_slow = self._w_fast = score
+        self._w_slow += p.recovery_alpha_slow * (score - self._w_slow)
+        self._w_fast += p.recovery_alpha_fast * (score - self._w_fast)
+
+    def _apply(self, weights: np.ndarray, base: Costmap2D) -> None:
+        """Weigh the cloud (lock held); in the likelihood-field model resample when the cloud
+        degenerates."""
+        if self.params.sensor_model == HIT_COUNT:
+            total = weights.sum()
+            if total > 0.0:
+                self.filter.weights = weights / total
+            else:
+                self._throttle.warn(self.logger, "no-hits",
+                                    f"{self.plugin_name}: no particle's points hit the map")
+            return
+        if not self.filter.correct(weights):
+            return
+        if self.filter.effective_sample_size() < 0.5 * len(self.filter):
+            self._resample(base)
+
+    def _resample(self, base: Costmap2D) -> None:
+        p = self.params
+        count = None
+        if p.kld_sampling:
+            count = kld_particle_count(self.filter.poses, p.pf_err, p.pf_z, p.min_particles,
+                                       p.max_particles)
+        self.filter.resample(count)
+        self._inject_random(base)
+        self._generation += 1
+
+    def _reseed(self, base: Costmap2D) -> None:
+        # hit_count never resamples between reseeds: KLD resizes the cloud here. (The
+        # likelihood-field model resizes at its resamples only: resizing at every reseed
+        # shrank a global cloud onto wrong modes before the scans had told them apart.)
+        if self.params.sensor_model == HIT_COUNT and self.params.kld_sampling:
+            self._resample(base)
+        else:
+            self._inject_random(base)
+        self.filter.reseed_worst_half(self.min_noise_xy, self.min_noise_yaw)
+        self._generation += 1  # hit counters restart with the new cloud
+
+    def _inject_random(self, base: Costmap2D) -> None:
+        """Augmented MCL: redraw ``1 - w_fast/w_slow`` of the cloud over the free space."""
+        if self._w_slow <= 0.0:
+            return
+        share = max(0.0, 1.0 - self._w_fast / self._w_slow)
+        count = int(share * len(self.filter))
+        if count == 0:
+            return
+        order = np.argsort(self.filter.weights, kind="stable")[:count]  # the least likely
+        try:
+            self.filter.poses[order] = sample_free_space(base, count, self.filter.rng)
+        except ValueError:
+            return
+        self.filter.weights[order] = self.filter.weights.mean()
+        self.filter.weights /= self.filter.weights.sum()
+        self._w_slow = self._w_fast = 0.0
+        self.logger.info(f"{self.plugin_name}: {count} particles redrawn over the free space "
+                         f"(scores fell: kidnapped?)")
+
+    def _spread_globally(self, base: Costmap2D) -> None:
+        p = self.params
+        count = int(p.max_particles if p.kld_sampling else p.num_particles)
+        try:
+            poses = sample_free_space(base, count, self.filter.rng)
+        except ValueError as exc:
+            self.logger.warning(f"{self.plugin_name}: global localisation impossible: {exc}")
+            return
+        with self._lock:
+            self._generation += 1
+            self.filter.replace(poses)
+        self._w_slow = self._w_fast = 0.0
+        self._last_reseed = self.now()
+        self.logger.info(f"{self.plugin_name}: global localisation: {count} particles over "
+                         "the free space")
+
+    # -- ROS ----------------------------------------------------------------------------------
+    def _create_ros(self) -> None:
+        super()._create_ros()
+        node = self.context.node
+        if self.params.compute_odom_from_tf:
+            node.destroy_subscription(self._ros.pop("odom"))
+        try:
+            from std_srvs.srv import Empty
+        except ImportError:
+            self.logger.warning(f"{self.plugin_name}: std_srvs is not installed: no "
+                                "reinitialize_global_localization service")
+            return
+        # Relative, like Nav2's AMCL: /reinitialize_global_localization in the node's namespace.
+        self._service = node.create_service(
+            Empty, "reinitialize_global_localization", self._on_global_localization
+        )
+
+    def _destroy_ros(self) -> None:
+        service, self._service = self._service, None
+        if service is not None and self.context.node is not None:
+            self.context.node.destroy_service(service)
+        super()._destroy_ros()
+
+    def _on_global_localization(self, request, response):
+        self.request_global_localization()
+        return response

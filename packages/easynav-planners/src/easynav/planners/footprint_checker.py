@@ -1,0 +1,144 @@
+"""FootprintChecker: is a circular robot at (x, y) clear of the obstacles of a Costmap2D?"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+from easynav.core.types import LETHAL_OBSTACLE, NO_INFORMATION, Costmap2D
+
+
+class FootprintChecker:
+    """Collision test of a disc of radius ``radius`` on a :class:`Costmap2D`.
+
+    A cell is an obstacle when its cost is ``>= obstacle_cost`` (254, lethal, by default);
+    unknown cells (255) are obstacles unless ``allow_unknown``; the area beyond the map edge is
+    an obstacle. A position is **free** when no obstacle cell centre lies within ``radius`` of
+    it. The test is conservative: the clearance of a position is taken as the distance between
+    the centre of its cell and the nearest obstacle cell centre (OpenCV's exact Euclidean
+    distance transform) minus half a cell diagonal, so a free position never has an obstacle
+    cell centre within ``radius`` (the rule the tests check directly).
+
+    Thread contract: immutable after construction; any thread may call it.
+    Exceptions: :class:`ValueError` for a radius or cost out of range or an empty costmap.
+    """
+
+    def __init__(
+        self,
+        costmap: Costmap2D,
+        radius: float,
+        obstacle_cost: int = LETHAL_OBSTACLE,
+        allow_unknown: bool = False,
+    ) -> None:
+        radius = float(radius)
+        if not math.isfinite(radius) or radius < 0.0:
+            raise ValueError(f"footprint radius = {radius} must be finite and >= 0")
+        if not 1 <= int(obstacle_cost) <= 255:
+            raise ValueError(f"obstacle_cost = {obstacle_cost} must be in [1, 255]")
+        if costmap.width == 0 or costmap.height == 0:
+            raise ValueError("the costmap is empty (0 cells)")
+        self.costmap = costmap
+        self.obstacle_cost = int(obstacle_cost)
+        self.allow_unknown = bool(allow_unknown)
+        data = costmap.data
+        obstacle = data >= self.obstacle_cost
+        if self.allow_unknown:
+            obstacle &= data != NO_INFORMATION
+        self.obstacle = obstacle
+        # A ring of obstacle cells around the map keeps the robot inside it.
+        free = np.pad(~obstacle, 1, constant_values=False).astype(np.uint8)
+        distance = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+        res = costmap.resolution
+        # Any point of a cell is within half a diagonal of its centre.
+        self.clearance = distance.astype(np.float64) * res - res * math.sqrt(0.5)
+        self._ox, self._oy, self._inv = costmap.origin_x, costmap.origin_y, 1.0 / res
+        self._w, self._h = costmap.width, costmap.height
+        self._set_radius(radius)
+
+    def _set_radius(self, radius: float) -> None:
+        self.radius = radius
+        self.free = self.clearance > radius
+        # Plain bytes rows for the scalar test OMPL calls per state (faster than numpy scalars).
+        self._free_rows = [bytes(row) for row in self.free.astype(np.uint8)]
+
+    def with_radius(self, radius: float) -> FootprintChecker:
+        """The same map with another disc radius (the distance transform is shared)."""
+        radius = float(radius)
+        if not math.isfinite(radius) or radius < 0.0:
+            raise ValueError(f"footprint radius = {radius} must be finite and >= 0")
+        other = object.__new__(FootprintChecker)
+        for name in (
+            "costmap", "obstacle_cost", "allow_unknown", "obstacle", "clearance",
+            "_ox", "_oy", "_inv", "_w", "_h",
+        ):
+            setattr(other, name, getattr(self, name))
+        other._set_radius(radius)
+        return other
+
+    def is_free(self, x: float, y: float) -> bool:
+        """Whether the disc at ``(x, y)`` is clear (False off the map or for non-finite input)."""
+        fx = (x - self._ox) * self._inv
+        fy = (y - self._oy) * self._inv
+        if not (0.0 <= fx < self._w and 0.0 <= fy < self._h):  # NaN fails too
+            return False
+        return self._free_rows[int(fy)][int(fx)] == 1
+
+    @property
+    def origin_x(self) -> float:
+        """The costmap's origin x (m)."""
+        return self._ox
+
+    @property
+    def origin_y(self) -> float:
+        """The costmap's origin y (m)."""
+        return self._oy
+
+    @property
+    def cells_per_m(self) -> float:
+        """``1 / resolution``."""
+        return self._inv
+
+    def is_on_map(self, x: float, y: float) -> bool:
+        """Whether ``(x, y)`` is on the costmap (False for non-finite input)."""
+        fx = (x - self._ox) * self._inv
+        fy = (y - self._oy) * self._inv
+        return 0.0 <= fx < self._w and 0.0 <= fy < self._h
+
+    def are_free(self, xy: np.ndarray) -> np.ndarray:
+        """Vectorised :meth:`is_free` of an ``(N, 2)`` array of positions."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        finite = np.isfinite(xy).all(axis=1)
+        ix, iy = self.costmap.world_to_cell(*np.where(finite[:, None], xy, 0.0).T)
+        inside = self.costmap.in_bounds(ix, iy) & finite
+        result = np.zeros(len(xy), dtype=bool)
+        result[inside] = self.free[iy[inside], ix[inside]]
+        return result
+
+    def polyline_free(self, xy: np.ndarray, step: float | None = None) -> tuple[bool, int]:
+        """Whether the straight segments joining ``xy`` (``(N, 2)``) are free, sampled every
+        ``step`` (half a cell by default). Returns ``(ok, index)``: ``index`` is the first
+        vertex whose outgoing segment (or itself) is not free, -1 when all are."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        if len(xy) == 0:
+            return True, -1
+        step = 0.5 * self.costmap.resolution if step is None else float(step)
+        if not self.is_free(float(xy[0, 0]), float(xy[0, 1])):
+            return False, 0
+        for i in range(len(xy) - 1):
+            a, b = xy[i], xy[i + 1]
+            n = max(1, math.ceil(float(np.hypot(*(b - a))) / step))
+            t = np.arange(1, n + 1, dtype=float)[:, None] / n
+            if not self.are_free(a + t * (b - a)).all():
+                return False, i
+        return True, -1
+
+    def nearest_obstacle_distance(self, x: float, y: float) -> float:
+        """Exact distance (m) from ``(x, y)`` to the nearest obstacle cell centre (inf if none);
+        a brute-force reference for tests and reports, not for hot paths."""
+        iy, ix = np.nonzero(self.obstacle)
+        if len(ix) == 0:
+            return math.inf
+        cx, cy = self.costmap.cell_to_world(ix, iy)
+        return float(np.min(np.hypot(cx - x, cy - y)))

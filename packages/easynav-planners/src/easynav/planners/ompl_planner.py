@@ -1,0 +1,314 @@
+"""OMPLPlanner (easynav_ompl_planner/OMPLPlanner): sampling-based planning with OMPL."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from easynav.core.diagnostics import write_diagnostic
+from easynav.core.nav_state import NavState
+from easynav.core.nav_state_keys import GOALS, PATH, ROBOT_POSE
+from easynav.core.plugins import (
+    Param,
+    ParameterValueError,
+    PlannerMethodBase,
+    PluginConfigurationError,
+    Topic,
+)
+from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import (
+    LETHAL_OBSTACLE,
+    Costmap2D,
+    DiagnosticLevel,
+    DiagnosticStatus,
+    Goals,
+    Header,
+    Odometry,
+    Path,
+)
+from easynav.planners.ompl_grid_planner import PLANNERS, STATE_SPACES, OMPLGridPlanner
+from easynav.planners.planner_keys import DIAGNOSTICS_PATH, MAP, STATIC_MAP
+
+#: The planner's diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
+DIAGNOSTIC_NAME = "path"
+HARDWARE_ID = "planner"
+#: Parameters that shape the OMPL planner (a change rebuilds it and drops the current path).
+_PLANNER_PARAMETERS = (
+    "state_space",
+    "planner",
+    "turning_radius",
+    "solve_time",
+    "clearance_distance",
+    "simplify",
+    "interpolation_step",
+    "seed",
+    "obstacle_cost",
+    "allow_unknown",
+    "max_iterations",
+    "range",
+)
+
+
+def as_costmap(world: Any) -> Costmap2D:
+    """``world`` as a :class:`Costmap2D`: itself, or a SimpleMap's occupied cells as lethal.
+
+    Raises :class:`TypeError` naming the type for anything else.
+    """
+    if isinstance(world, Costmap2D):
+        return world
+    cells = getattr(world, "cells", None)
+    if isinstance(cells, np.ndarray) and cells.dtype == bool:
+        data = np.where(cells, LETHAL_OBSTACLE, 0).astype(np.uint8)
+        return Costmap2D(data, world.resolution, world.origin_x, world.origin_y)
+    raise TypeError(f"NavState '{MAP}' holds a {type(world).__name__}, not a Costmap2D")
+
+
+class OMPLPlanner(PlannerMethodBase):
+    """Plans to the first goal with OMPL (:class:`OMPLGridPlanner`) on NavState ``map``.
+
+    The robot is a disc of ``system_node.robot_geometry.radius`` + ``clearance_distance``; the
+    state space is SE2, Dubins or Reeds–Shepp (``turning_radius``); ``planner`` names the OMPL
+    planner, run for at most ``solve_time`` seconds. A plan is kept (and written again each
+    cycle) while the goal is the same, the part of the path ahead of the robot stays clear on the
+    current ``map`` and the robot stays within ``replan_deviation`` of it; otherwise the planner
+    plans again from the robot's pose. An unreachable goal gives an empty path and a WARN
+    diagnostic naming it; a goal impossible on the static map (``map.base``: off the map,
+    inside or too close to a wall) is rejected (the mission aborts). A path is never written
+    unless its interpolated poses, joined by straight segments, are clear of obstacles.
+
+    Thread contract: ``initialize`` and runtime parameter changes in the configuring / parameter
+    thread while the loops do not run this plugin; ``update`` in the non-RT thread (it blocks it
+    for up to ``solve_time`` when it plans).
+    Exceptions: :class:`PluginConfigurationError` naming the parameter (or the missing ``ompl``
+    extra); ``update`` does not raise for unreachable goals (it reports them).
+    """
+
+    PARAMETERS = (
+        Param("freq", 1.0, "how often the path is checked (and replanned when needed)", "Hz",
+              gt=0.0),
+        Param("state_space", "SE2", "SE2 (turns on the spot), Dubins (forward car) or "
+              "ReedsShepp (car with reverse)", choices=STATE_SPACES),
+        Param("planner", "RRTConnect", "the OMPL geometric planner", choices=PLANNERS),
+        Param("turning_radius", 0.5, "minimum turning radius (Dubins, ReedsShepp)", "m", gt=0.0),
+        Param("solve_time", 1.0, "time budget of one plan", "s", gt=0.0),
+        Param("clearance_distance", 0.2, "distance kept from obstacles beyond the robot radius "
+              "(a follower cuts corners of the path)", "m", ge=0.0),
+        Param("simplify", True, "shorten the solution (OMPL's PathSimplifier)"),
+        Param("interpolation_step", 0.1, "spacing of the poses of the path", "m", gt=0.0),
+        Param("seed", 0, "OMPL's random seed: > 0 gives repeatable plans; 0 a new seed each time",
+              ge=0),
+        Param("obstacle_cost", LETHAL_OBSTACLE, "costmap cost from which a cell is an obstacle",
+              ge=1, le=255),
+        Param("allow_unknown", False, "unknown cells (255) are not obstacles"),
+        Param("max_iterations", 0, "stop after this many planner iterations (0: time only)",
+              ge=0),
+        Param("range", 0.0, "maximum extension of tree planners (0: OMPL's default)", "m",
+              ge=0.0),
+        Param("replan_deviation", 0.5, "replan when the robot is farther than this from the path",
+              "m", gt=0.0),
+    )
+    TOPICS = (Topic("path", "nav_msgs/msg/Path", "pub", description="every new plan"),)
+    READS = (GOALS, ROBOT_POSE, MAP, STATIC_MAP)
+    WRITES = (PATH, DIAGNOSTICS_PATH)
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.planner: OMPLGridPlanner | None = None
+        self._throttle = WarningThrottle(period=5.0)
+        self._last_status: tuple[int, str] | None = None
+        self._publisher = None
+        self._path: Path | None = None
+        self._path_xy_yaw: np.ndarray | None = None
+        self._path_goal: tuple | None = None
+        self._map_source: Any = None
+        self._map_costmap: Costmap2D | None = None
+        #: Plans made since initialisation (for tests and tools).
+        self.plan_count = 0
+
+    # -- configuration ----------------------------------------------------------------------
+    def _build(self, overrides: dict[str, Any] | None = None) -> OMPLGridPlanner:
+        values = {name: self.params[name] for name in _PLANNER_PARAMETERS}
+        values.update(overrides or {})
+        return OMPLGridPlanner(
+            state_space=values["state_space"],
+            planner=values["planner"],
+            turning_radius=values["turning_radius"],
+            solve_time=values["solve_time"],
+            robot_radius=self.get_robot_geometry().radius,
+            clearance_distance=values["clearance_distance"],
+            simplify=values["simplify"],
+            interpolation_step=values["interpolation_step"],
+            seed=values["seed"],
+            obstacle_cost=values["obstacle_cost"],
+            allow_unknown=values["allow_unknown"],
+            max_iterations=values["max_iterations"],
+            range=values["range"],
+        )
+
+    def on_initialize(self) -> None:
+        self._destroy_publisher()
+        try:
+            self.planner = self._build()
+        except (ValueError, ImportError) as exc:
+            raise PluginConfigurationError(f"{self.plugin_name}: {exc}") from None
+        self._forget_path()
+        self._last_status = None
+        node = self.context.node
+        if node is not None:
+            from nav_msgs.msg import Path as PathMsg
+
+            topic = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}/path"
+            self._publisher = node.create_publisher(PathMsg, topic, 10)
+
+    def validate_parameter(self, name: str, value: Any) -> Any:
+        """As the base, and a combination OMPL cannot plan with (FMT in Dubins) is refused."""
+        converted = super().validate_parameter(name, value)
+        if name in _PLANNER_PARAMETERS:
+            try:
+                self._build({name: converted})
+            except ValueError as exc:
+                raise ParameterValueError(f"{self.plugin_name}.{name}: {exc}") from None
+        return converted
+
+    def on_parameter_changed(self, name: str, value: Any) -> None:
+        """Rebuild the OMPL planner; the next update plans afresh."""
+        if name in _PLANNER_PARAMETERS:
+            self.planner = self._build()
+            self._forget_path()
+
+    def on_cleanup(self) -> None:
+        self._destroy_publisher()
+        self._forget_path()
+
+    def _destroy_publisher(self) -> None:
+        if self._publisher is not None and self.context.node is not None:
+            self.context.node.destroy_publisher(self._publisher)
+        self._publisher = None
+
+    def _forget_path(self) -> None:
+        self._path = None
+        self._path_xy_yaw = None
+        self._path_goal = None
+
+    # -- update -------------------------------------------------------------------------------
+    def _costmap(self, world: Any) -> Costmap2D:
+        if world is not self._map_source:
+            self._map_costmap = as_costmap(world)
+            self._map_source = world
+        return self._map_costmap
+
+    def update(self, nav_state: NavState) -> None:
+        """Check the current path; plan again when needed; write ``path``. Non-RT thread."""
+        if not nav_state.has(GOALS) or self.planner is None:
+            return
+        planner = self.planner
+        map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
+        goals = nav_state.get(GOALS, Goals)
+        if len(goals) == 0:
+            self._forget_path()
+            self._write(nav_state, Path(Header(self.now(), map_frame)), None, "idle: no goal")
+            return
+        goal = goals.goals[0]
+        gx, gy, gyaw = goal.pose.x, goal.pose.y, goal.pose.yaw
+        goal_text = f"goal ({gx:.2f}, {gy:.2f})"
+        frame = goal.header.frame_id or goals.header.frame_id
+        if frame and frame != map_frame:
+            self._forget_path()
+            reason = f"{goal_text} is in frame '{frame}', not '{map_frame}'"
+            self.reject_goal(reason)
+            self._fail(nav_state, map_frame, reason)
+            return
+        try:
+            if nav_state.has(STATIC_MAP):
+                static = as_costmap(nav_state.get(STATIC_MAP))
+                problem = planner.pose_problem(static, gx, gy, "goal")
+                if problem is not None:
+                    self._forget_path()
+                    self.reject_goal(problem)
+                    self._fail(nav_state, map_frame, problem)
+                    return
+            if not nav_state.has(ROBOT_POSE):
+                self._fail(nav_state, map_frame, f"{goal_text}: no robot_pose yet")
+                return
+            robot = nav_state.get(ROBOT_POSE, Odometry)
+            if not robot.is_finite():
+                self._fail(nav_state, map_frame, f"{goal_text}: robot_pose is not finite")
+                return
+            if not nav_state.has(MAP):
+                self._fail(nav_state, map_frame, f"{goal_text}: no map yet (NavState '{MAP}')")
+                return
+            costmap = self._costmap(nav_state.get(MAP))
+        except TypeError as exc:
+            self._fail(nav_state, map_frame, f"{goal_text}: {exc}")
+            return
+        goal_key = (gx, gy, gyaw, frame)
+        robot_xy = (robot.pose.x, robot.pose.y)
+        if self._path is not None and self._path_goal == goal_key:
+            if self._path_still_good(costmap, robot_xy):
+                nav_state.set(PATH, self._path)
+                return
+        self._forget_path()
+        result = planner.plan(costmap, (robot.pose.x, robot.pose.y, robot.pose.yaw),
+                              (gx, gy, gyaw))
+        self.plan_count += 1
+        if not result.ok:
+            self._fail(nav_state, map_frame, result.reason)
+            return
+        path = Path.from_xy_yaw(result.poses, Header(self.now(), map_frame))
+        self._path, self._path_xy_yaw, self._path_goal = path, result.poses, goal_key
+        stats = planner.last_stats
+        self.logger.debug(
+            f"{self.plugin_name}: {planner.planner} in {planner.state_space}: path of "
+            f"{result.length:.2f} m to {goal_text} in {stats.solve_time:.3f} s "
+            f"({stats.validity_checks} validity checks)"
+        )
+        self._write(nav_state, path, None, f"path of {result.length:.2f} m to {goal_text}")
+
+    def _path_still_good(self, costmap: Costmap2D, robot_xy: tuple[float, float]) -> bool:
+        """Whether the robot is near the current path and the path ahead of it is clear."""
+        xy = self._path_xy_yaw[:, :2]
+        distance = np.hypot(xy[:, 0] - robot_xy[0], xy[:, 1] - robot_xy[1])
+        nearest = float(distance.min())
+        if nearest > self.params.replan_deviation:
+            return False
+        # The first pose about as near as the nearest: with cusps (Reeds–Shepp) a path passes
+        # near the same place twice, and the earlier pass is the one still ahead.
+        ahead = int(np.argmax(distance <= nearest + 0.1))
+        footprint = self.planner.checker(costmap)
+        # A path may start with an escape out of the clearance, which only the body clears.
+        clear = footprint.are_free(xy[ahead:])
+        escape = int(np.argmax(clear)) if clear.any() else len(clear) - 1
+        body = self.planner.body_checker(costmap)
+        return (
+            body.polyline_free(xy[ahead : ahead + escape + 1])[0]
+            and footprint.polyline_free(xy[ahead + escape :])[0]
+        )
+
+    def _fail(self, nav_state: NavState, map_frame: str, reason: str) -> None:
+        self._throttle.warn(self.logger, reason, f"{self.plugin_name}: no path: {reason}")
+        self._write(nav_state, Path(Header(self.now(), map_frame)), reason, reason)
+
+    def _write(self, nav_state: NavState, path: Path, failure: str | None, message: str) -> None:
+        nav_state.set(PATH, path)
+        level = DiagnosticLevel.WARN if failure else DiagnosticLevel.OK
+        # Written on changes only; a new plan to the same goal is not news.
+        summary = (int(level), failure or message.split(" m to ")[-1])
+        if summary != self._last_status:
+            self._last_status = summary
+            write_diagnostic(
+                nav_state,
+                DIAGNOSTIC_NAME,
+                DiagnosticStatus(
+                    level=level,
+                    message=message,
+                    hardware_id=HARDWARE_ID,
+                    values={"poses": str(len(path)), "plugin": self.plugin_name},
+                ),
+            )
+        publisher = self._publisher
+        if publisher is not None and publisher.get_subscription_count() > 0:
+            from easynav.core.ros.converters import path_to_msg
+
+            publisher.publish(path_to_msg(path))

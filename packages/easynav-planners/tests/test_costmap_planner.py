@@ -1,0 +1,198 @@
+"""CostmapPlanner without ROS: NavState in and out, unreachable goals, replanning, stamps."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
+from easynav.core.types import (
+    Costmap2D,
+    DiagnosticLevel,
+    DiagnosticStatus,
+    Goals,
+    Header,
+    Odometry,
+    Path,
+    Pose,
+    PoseStamped,
+)
+from easynav.planners.costmap_planner import CostmapPlanner, smooth_path
+
+_namespaces = itertools.count()
+
+
+def room() -> Costmap2D:
+    """8 x 4 m at 0.05 m, walls around, a wall at x = 4 m with a door at y 2.4..3.6, the wall
+    inflated by 0.25 m (253) and graded costs up to 0.5 m."""
+    data = np.zeros((80, 160), dtype=np.uint8)
+    data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 254
+    data[0:48, 80:82] = 254
+    data[72:80, 80:82] = 254
+    # Inflate with the original's formula (inscribed 0.25 m, k = 3) via brute force distances.
+    walls = np.argwhere(data == 254)
+    yy, xx = np.mgrid[0:80, 0:160]
+    dist = np.full(data.shape, np.inf)
+    for y, x in walls:
+        dist = np.minimum(dist, np.hypot(yy - y, xx - x) * 0.05)
+    graded = np.where(dist <= 0.25, 253, np.floor(252 * np.exp(-3.0 * (dist - 0.25))))
+    graded[dist > 0.5] = 0
+    data = np.maximum(data, graded.astype(np.uint8))
+    return Costmap2D(data, 0.05, 0.0, 0.0, "map", 4.5)
+
+
+def make_planner(params=None) -> CostmapPlanner:
+    context = PluginContext(
+        parameters=DictParameters({f"costmap.{k}": v for k, v in (params or {}).items()}),
+        namespace=f"costmap_planner_test_{next(_namespaces)}",
+        now=lambda: 7.0,
+    )
+    planner = CostmapPlanner()
+    planner.initialize(context, "costmap")
+    return planner
+
+
+def state_with(goal, robot_xy=(1.0, 1.0), frame="map", costmap=None) -> NavState:
+    nav_state = NavState()
+    costmap = costmap or room()
+    nav_state.set("map", costmap)
+    nav_state.set("map.base", costmap)
+    nav_state.set("map_time", 4.5)
+    nav_state.set(
+        "robot_pose",
+        Odometry(Header(3.0, "map"), "base_footprint", Pose.from_xy_yaw(*robot_xy, 0.0)),
+    )
+    g = PoseStamped(Header(5.0, frame), Pose.from_xy_yaw(*goal))
+    nav_state.set("goals", Goals(Header(5.0, frame), [g]))
+    return nav_state
+
+
+def diagnostic(nav_state) -> DiagnosticStatus:
+    status = nav_state.get("diagnostics.path", DiagnosticStatus)
+    assert status.hardware_id == "planner"
+    return status
+
+
+def xy(path: Path) -> np.ndarray:
+    return np.array([[p.x, p.y] for p in path.poses])
+
+
+def test_plans_through_the_door_and_ends_at_the_goal_pose():
+    planner = make_planner()
+    nav_state = state_with((7.0, 1.0, 1.5))
+    planner.update(nav_state)
+    path = nav_state.get("path", Path)
+    assert path.header.frame_id == "map" and path.header.stamp == 4.5  # map_time
+    points = xy(path)
+    assert points[-1] == pytest.approx([7.0, 1.0])
+    assert path.poses[-1].yaw == pytest.approx(1.5)
+    # It crosses the wall through the door, never through the inscribed zone.
+    costs = room().cost_at(points[:, 0], points[:, 1])
+    assert (costs < 253).all()
+    crossing = points[np.argmin(np.abs(points[:, 0] - 4.05))]
+    assert 2.4 < crossing[1] < 3.6
+    # Consecutive poses are about one cell apart; each faces the next.
+    steps = np.hypot(*np.diff(points, axis=0).T)
+    assert steps.max() < 0.1
+    heading = np.arctan2(*np.diff(points, axis=0)[:3].T[::-1])
+    assert [p.yaw for p in path.poses[:3]] == pytest.approx(list(heading))
+    status = diagnostic(nav_state)
+    assert status.level == DiagnosticLevel.OK and "path of" in status.message
+
+
+def test_a_blocked_route_gives_an_empty_path_and_a_warning_not_the_goal():
+    costmap = room()
+    costmap.data[48:72, 80:82] = 254  # the door closed by a live obstacle
+    planner = make_planner()
+    nav_state = state_with((7.0, 1.0, 0.0), costmap=costmap)
+    nav_state.set("map.base", room())  # the static map still has the door
+    planner.update(nav_state)
+    assert len(nav_state.get("path", Path)) == 0
+    status = diagnostic(nav_state)
+    assert status.level == DiagnosticLevel.WARN
+    assert "no route from (1.00, 1.00) to goal (7.00, 1.00)" in status.message
+    assert planner.take_goal_rejection() is None  # the recovery system decides
+
+
+@pytest.mark.parametrize(
+    ("goal", "reason"),
+    [
+        ((20.0, 1.0, 0.0), "is off the map [0.00, 8.00] x [0.00, 4.00]"),
+        ((4.02, 1.0, 0.0), "is on an obstacle of the static map"),
+    ],
+)
+def test_goals_that_can_never_be_reached_are_rejected(goal, reason):
+    planner = make_planner()
+    nav_state = state_with(goal)
+    planner.update(nav_state)
+    assert len(nav_state.get("path", Path)) == 0
+    assert reason in diagnostic(nav_state).message
+    assert reason in planner.take_goal_rejection()
+
+
+def test_a_goal_in_the_inflated_zone_is_reported_with_its_cost():
+    planner = make_planner()
+    nav_state = state_with((3.9, 1.0, 0.0))
+    planner.update(nav_state)
+    assert len(nav_state.get("path", Path)) == 0
+    assert "inside the inflated zone of an obstacle (cost 253)" in diagnostic(nav_state).message
+
+
+def test_a_goal_in_another_frame_is_rejected():
+    planner = make_planner()
+    nav_state = state_with((7.0, 1.0, 0.0), frame="odom")
+    planner.update(nav_state)
+    assert "is in frame 'odom', not 'map'" in planner.take_goal_rejection()
+
+
+def test_cost_factor_keeps_the_path_off_graded_cells():
+    near, far = [], []
+    for factor, out in ((0.0, near), (5.0, far)):
+        # Through the door (y 2.4..3.6) from below its middle: the shortest way grazes the
+        # graded cells at the door's lower edge.
+        nav_state = state_with((7.0, 2.0, 0.0), robot_xy=(1.0, 2.0))
+        make_planner({"cost_factor": factor}).update(nav_state)
+        points = xy(nav_state.get("path", Path))
+        out.append(room().cost_at(points[:, 0], points[:, 1]).astype(float).sum())
+    assert far[0] < near[0]
+
+
+def test_without_continuous_replan_the_path_is_kept_until_blocked():
+    planner = make_planner({"continuous_replan": False})
+    nav_state = state_with((7.0, 1.0, 0.0))
+    planner.update(nav_state)
+    first = nav_state.get("path", Path)
+    moved = Pose.from_xy_yaw(1.5, 1.2, 0.0)
+    nav_state.set("robot_pose", Odometry(Header(4.0, "map"), "base_footprint", moved))
+    planner.update(nav_state)
+    assert nav_state.get("path", Path) is first  # kept: same goal, nothing blocked
+    blocked = room()
+    points = xy(first)
+    ix, iy = blocked.world_to_cell(points[len(points) // 2, 0], points[len(points) // 2, 1])
+    blocked.data[iy - 2 : iy + 3, ix - 2 : ix + 3] = 254
+    nav_state.set("map", blocked)
+    planner.update(nav_state)
+    replanned = nav_state.get("path", Path)
+    assert replanned is not first and len(replanned) > 0
+
+
+def test_no_goal_writes_an_empty_path_and_bad_parameters_fail_configure():
+    planner = make_planner()
+    nav_state = state_with((7.0, 1.0, 0.0))
+    nav_state.set("goals", Goals(Header(5.0, "map"), []))
+    planner.update(nav_state)
+    assert len(nav_state.get("path", Path)) == 0
+    with pytest.raises(PluginConfigurationError, match="costmap.heuristic_scale"):
+        make_planner({"heuristic_scale": 0.0})
+
+
+def test_smoothing_keeps_the_ends_and_straight_lines():
+    line = np.column_stack((np.arange(10.0), np.zeros(10)))
+    assert smooth_path(line) == pytest.approx(line)
+    corner = np.array([[0, 0], [1, 0], [2, 0], [2, 1], [2, 2]], dtype=float)
+    smoothed = smooth_path(corner)
+    assert smoothed[0] == pytest.approx([0, 0]) and smoothed[-1] == pytest.approx([2, 2])
+    assert smoothed[2] == pytest.approx([1.4, 0.6])  # the corner is cut

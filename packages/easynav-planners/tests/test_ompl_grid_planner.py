@@ -1,0 +1,337 @@
+"""OMPLGridPlanner and FootprintChecker without ROS: every path checked by direct computation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from easynav.core.types import Costmap2D
+
+pytest.importorskip("ompl", reason="the OMPL planner needs the [ompl] extra")
+
+from easynav.planners.footprint_checker import FootprintChecker  # noqa: E402
+from easynav.planners.ompl_grid_planner import (  # noqa: E402
+    ANYTIME_PLANNERS,
+    PLANNERS,
+    THREADED_PLANNERS,
+    OMPLGridPlanner,
+)
+
+#: A budget no plan expected to succeed needs, even on a loaded machine (the planners used stop
+#: at their first solution or at max_iterations).
+LONG = 60.0
+
+
+def bounded(planner: str) -> dict:
+    """A budget bounded by work, not the clock, where OMPL allows it: the same result however
+    loaded the machine is. First-solution planners stop by themselves (LONG budget); anytime
+    ones after 800 iterations; PRM and PRM* (threaded: clock only) after 5 s, a hundred times
+    what they need on an idle machine."""
+    if planner in THREADED_PLANNERS:
+        return {"solve_time": 5.0}
+    if planner in ANYTIME_PLANNERS:
+        return {"solve_time": LONG, "max_iterations": 800}
+    return {"solve_time": LONG}
+
+
+def make(*args, **kwargs) -> OMPLGridPlanner:
+    """An OMPLGridPlanner with the LONG budget unless told otherwise."""
+    kwargs.setdefault("solve_time", LONG)
+    return OMPLGridPlanner(*args, **kwargs)
+
+
+def wall_map() -> Costmap2D:
+    """10 m x 10 m at 0.05 m, a wall x 4.75..5.25 from y = 0 to 8 (pass above it)."""
+    costmap = Costmap2D.filled(200, 200, 0.05)
+    costmap.data[0:160, 95:105] = 254
+    return costmap
+
+
+def clutter_map(seed: int = 4) -> Costmap2D:
+    """8 m x 6 m with random boxes (lethal), inflation-like graded cells and unknown patches."""
+    rng = np.random.default_rng(seed)
+    costmap = Costmap2D.filled(160, 120, 0.05, origin_x=-1.0, origin_y=-2.0)
+    for _ in range(14):
+        x, y = rng.integers(10, 150), rng.integers(10, 110)
+        w, h = rng.integers(3, 16), rng.integers(3, 16)
+        costmap.data[y : y + h, x : x + w] = 254
+    costmap.data[costmap.data == 0] = rng.integers(0, 200, int((costmap.data == 0).sum()))
+    costmap.data[0:4, 0:20] = 255
+    # Keep the start and goal areas clear.
+    costmap.data[8:30, 4:26] = 0
+    costmap.data[90:112, 134:156] = 0
+    return costmap
+
+
+def obstacle_centres(costmap: Costmap2D) -> np.ndarray:
+    iy, ix = np.nonzero(costmap.data >= 254)
+    return np.stack(costmap.cell_to_world(ix, iy), axis=1)
+
+
+def assert_clear(costmap: Costmap2D, poses: np.ndarray, radius: float) -> None:
+    """Every point of the polyline (sampled at a quarter cell) is on the map and farther than
+    ``radius`` from every obstacle cell centre: brute force, independent of FootprintChecker."""
+    xy = poses[:, :2]
+    step = 0.25 * costmap.resolution
+    samples = [xy[:1]]
+    for a, b in zip(xy[:-1], xy[1:], strict=True):
+        n = max(1, math.ceil(float(np.hypot(*(b - a))) / step))
+        samples.append(a + (np.arange(1, n + 1)[:, None] / n) * (b - a))
+    points = np.concatenate(samples)
+    x0, y0, x1, y1 = costmap.extent()
+    assert (points[:, 0] >= x0).all() and (points[:, 0] < x1).all()
+    assert (points[:, 1] >= y0).all() and (points[:, 1] < y1).all()
+    centres = obstacle_centres(costmap)
+    for chunk in np.array_split(points, max(1, len(points) // 500)):
+        d = np.hypot(chunk[:, None, 0] - centres[None, :, 0],
+                     chunk[:, None, 1] - centres[None, :, 1])
+        assert d.min() > radius, f"a path point is {d.min():.3f} m from an obstacle"
+
+
+# -- FootprintChecker -------------------------------------------------------------------------
+
+
+def test_free_positions_have_no_obstacle_centre_within_the_radius():
+    costmap = clutter_map()
+    checker = FootprintChecker(costmap, 0.35)
+    centres = obstacle_centres(costmap)
+    rng = np.random.default_rng(1)
+    x0, y0, x1, y1 = costmap.extent()
+    points = np.stack([rng.uniform(x0, x1, 4000), rng.uniform(y0, y1, 4000)], axis=1)
+    free = checker.are_free(points)
+    assert free.any() and (~free).any()
+    d = np.hypot(points[:, None, 0] - centres[None, :, 0], points[:, None, 1] - centres[None, :, 1])
+    assert (d[free].min(axis=1) > 0.35).all()
+    # Conservative by at most a cell: points well clear of everything are free.
+    edge = np.minimum.reduce([points[:, 0] - x0, x1 - points[:, 0], points[:, 1] - y0,
+                              y1 - points[:, 1]])
+    clear = (d.min(axis=1) > 0.35 + 2 * costmap.resolution) & (edge > 0.35 + 0.1)
+    assert free[clear].all()
+    # The scalar test agrees with the vectorised one.
+    assert [checker.is_free(*p) for p in points[:300]] == free[:300].tolist()
+
+
+def test_off_the_map_and_nan_are_not_free_and_unknown_is_an_obstacle_unless_allowed():
+    costmap = Costmap2D.filled(40, 40, 0.1)
+    costmap.data[:, 30:] = 255
+    checker = FootprintChecker(costmap, 0.2)
+    assert checker.is_free(1.0, 2.0)
+    assert not checker.is_free(-0.5, 2.0) and not checker.is_free(math.nan, 2.0)
+    assert not checker.is_free(2.9, 2.0)
+    assert FootprintChecker(costmap, 0.2, allow_unknown=True).is_free(3.5, 2.0)
+    assert not checker.are_free(np.array([[math.nan, 1.0], [5.0, 1.0]])).any()
+
+
+def test_with_radius_shares_the_map_and_bad_arguments_are_named():
+    costmap = wall_map()
+    checker = FootprintChecker(costmap, 0.3)
+    wider = checker.with_radius(1.0)
+    assert wider.clearance is checker.clearance
+    assert checker.is_free(4.2, 4.0) and not wider.is_free(4.2, 4.0)
+    with pytest.raises(ValueError, match="radius"):
+        FootprintChecker(costmap, -1.0)
+    with pytest.raises(ValueError, match="obstacle_cost"):
+        FootprintChecker(costmap, 0.3, obstacle_cost=0)
+    with pytest.raises(ValueError, match="empty"):
+        FootprintChecker(Costmap2D(), 0.3)
+
+
+def test_polyline_check_finds_a_segment_through_a_wall():
+    checker = FootprintChecker(wall_map(), 0.3)
+    assert checker.polyline_free(np.array([[2.0, 2.0], [2.0, 5.0]])) == (True, -1)
+    assert checker.polyline_free(np.array([[2.0, 5.0], [2.0, 2.0], [8.0, 2.0]])) == (False, 1)
+
+
+# -- OMPLGridPlanner --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("space", "planner"),
+    [("SE2", "RRTConnect"), ("SE2", "RRTstar"), ("SE2", "PRMstar"), ("SE2", "BITstar"),
+     ("SE2", "KPIECE1"), ("Dubins", "RRTConnect"), ("Dubins", "InformedRRTstar"),
+     ("ReedsShepp", "RRTConnect"), ("ReedsShepp", "BITstar")],
+)
+def test_every_returned_path_is_clear_of_obstacles(space, planner):
+    costmap = clutter_map()
+    # Bounded by iterations, not the clock: the same work however loaded the machine is (the
+    # first-solution planners stop long before).
+    ompl = OMPLGridPlanner(space, planner, **bounded(planner), seed=7, robot_radius=0.25,
+                           clearance_distance=0.05, turning_radius=0.4)
+    start, goal = (-0.2, -1.0, 0.0), (5.7, 3.0, 1.0)
+    result = ompl.plan(costmap, start, goal)
+    assert result.ok, result.reason
+    assert result.poses[0, :2].tolist() == [-0.2, -1.0]
+    assert result.poses[-1].tolist() == pytest.approx(list(goal))
+    assert_clear(costmap, result.poses, 0.30)
+    spacing = np.hypot(*np.diff(result.poses[:, :2], axis=0).T)
+    assert spacing.max() <= 0.1 + 1e-6  # interpolated every interpolation_step
+
+
+def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(monkeypatch):
+    costmap = wall_map()
+    ompl = make("Dubins", seed=1, robot_radius=0.25, clearance_distance=0.05)
+    verify, _, strict = ompl._checkers(costmap)
+    # Plan first with half the radius: shortcuts then hug the wall's end too closely.
+    loose = verify.with_radius(0.15)
+    monkeypatch.setattr(ompl, "_checkers", lambda c: (verify, loose, strict))
+    radii = []
+    original = ompl._solve
+
+    def solve(costmap, checker, start, goal):
+        radii.append(checker.radius)
+        return original(costmap, checker, start, goal)
+
+    monkeypatch.setattr(ompl, "_solve", solve)
+    retried = 0
+    for seed in range(1, 9):
+        ompl.seed = seed
+        radii.clear()
+        result = ompl.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, -math.pi / 2))
+        assert result.ok, result.reason
+        assert_clear(costmap, result.poses, 0.30)
+        assert radii[0] == pytest.approx(0.15)
+        if len(radii) == 2:
+            retried += 1
+            assert radii[1] == pytest.approx(0.30 + (0.25 + math.sqrt(2.0)) * 0.05)
+    assert retried >= 2
+
+
+def test_se2_poses_face_the_next_one_and_the_last_has_the_goal_yaw():
+    result = make(seed=3).plan(wall_map(), (2.0, 2.0, 0.0), (8.0, 2.0, -2.0))
+    assert result.ok, result.reason
+    d = np.diff(result.poses[:, :2], axis=0)
+    assert np.allclose(result.poses[:-1, 2], np.arctan2(d[:, 1], d[:, 0]))
+    assert result.poses[-1, 2] == pytest.approx(-2.0)
+    assert result.poses[:, 1].max() > 8.0  # around the wall's end
+
+
+@pytest.mark.parametrize("radius", [0.5, 1.0])
+def test_dubins_paths_respect_the_turning_radius_and_never_reverse(radius):
+    ompl = make("Dubins", turning_radius=radius, seed=11, interpolation_step=0.05)
+    result = ompl.plan(wall_map(), (2.0, 2.0, math.pi / 2), (8.0, 2.0, -math.pi / 2))
+    assert result.ok, result.reason
+    poses = result.poses
+    step = np.hypot(*np.diff(poses[:, :2], axis=0).T)
+    turn = np.abs(np.angle(np.exp(1j * np.diff(poses[:, 2]))))
+    # Curvature: a chord of an arc of radius r turns by at most step / r (chord <= arc).
+    assert (turn <= step / radius * 1.02 + 1e-9).all()
+    heading = np.stack([np.cos(poses[:-1, 2]), np.sin(poses[:-1, 2])], axis=1)
+    assert (np.einsum("ij,ij->i", np.diff(poses[:, :2], axis=0), heading) > 0.0).all()
+
+
+def test_reeds_shepp_reverses_to_a_goal_just_behind():
+    ompl = make("ReedsShepp", turning_radius=1.0, seed=2, interpolation_step=0.05)
+    result = ompl.plan(wall_map(), (2.0, 2.0, 0.0), (1.0, 2.0, 0.0))
+    assert result.ok, result.reason
+    poses = result.poses
+    heading = np.stack([np.cos(poses[:-1, 2]), np.sin(poses[:-1, 2])], axis=1)
+    along = np.einsum("ij,ij->i", np.diff(poses[:, :2], axis=0), heading)
+    assert (along < 0.0).all()  # straight back, yaw kept
+    assert result.length == pytest.approx(1.0, abs=0.01)
+
+
+def test_the_same_seed_gives_the_same_path_and_another_seed_another():
+    costmap = clutter_map()
+    start, goal = (-0.2, -1.0, 0.0), (5.7, 3.0, 1.0)
+    for space in ("SE2", "ReedsShepp"):
+        first = make(space, seed=5, simplify=False).plan(costmap, start, goal)
+        # Other plans in between must not matter.
+        make(space, seed=0).plan(costmap, start, goal)
+        again = make(space, seed=5, simplify=False).plan(costmap, start, goal)
+        other = make(space, seed=6, simplify=False).plan(costmap, start, goal)
+        assert first.ok and again.ok and other.ok
+        assert np.array_equal(first.poses, again.poses)
+        assert not np.array_equal(first.poses, other.poses)
+
+
+def test_an_anytime_planner_is_repeatable_with_max_iterations():
+    costmap = wall_map()
+    paths = [
+        OMPLGridPlanner(planner="RRTstar", seed=9, max_iterations=300, solve_time=30.0)
+        .plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, 0.0)).poses
+        for _ in range(2)
+    ]
+    assert len(paths[0]) > 0 and np.array_equal(paths[0], paths[1])
+
+
+def test_an_unreachable_goal_is_reported_as_such():
+    costmap = wall_map()
+    costmap.data[160:, 95:105] = 254  # the wall now closes the map
+    result = OMPLGridPlanner(solve_time=0.2, seed=1).plan(costmap, (2.0, 2.0, 0.0),
+                                                           (8.0, 2.0, 0.0))
+    assert not result.ok and len(result.poses) == 0
+    assert "goal (8.00, 2.00) is unreachable from (2.00, 2.00)" in result.reason
+    assert "RRTConnect in SE2" in result.reason
+
+
+@pytest.mark.parametrize(("space", "yaw"), [("SE2", 0.0), ("ReedsShepp", 0.0), ("Dubins", 3.0)])
+def test_a_robot_inside_the_clearance_escapes_along_a_segment_its_body_clears(space, yaw):
+    costmap = wall_map()
+    # 0.35 m left of the wall (x 4.75): inside the 0.4 m footprint, the 0.3 m body clear. Facing
+    # the wall, a Reeds-Shepp car backs out; a Dubins car (facing away) drives out ahead.
+    robot = (4.40, 4.0, yaw)
+    ompl = make(space, seed=4, robot_radius=0.3, clearance_distance=0.1, turning_radius=0.4)
+    result = ompl.plan(costmap, robot, (2.0, 2.0, 0.0))
+    assert result.ok, result.reason
+    poses = result.poses
+    assert poses[0, :2].tolist() == [4.40, 4.0]
+    assert_clear(costmap, poses, 0.30)  # the body never touches the wall
+    # It leaves the clearance first: the distance to the wall grows along the escape.
+    assert poses[1, 0] < poses[0, 0]
+    if space != "SE2":
+        assert poses[1, 2] == pytest.approx(yaw)  # straight out along the heading, yaw kept
+    # Past the escape, the footprint (body + clearance) is clear again.
+    first_clear = int(np.argmax(ompl.checker(costmap).are_free(poses[:, :2])))
+    assert_clear(costmap, poses[first_clear:], 0.40)
+
+
+def test_a_robot_touching_an_obstacle_has_no_escape():
+    result = make(seed=1).plan(wall_map(), (4.55, 4.0, 0.0), (2.0, 2.0, 0.0))
+    assert not result.ok and "start (4.55, 4.00) is closer than" in result.reason
+
+
+@pytest.mark.parametrize(
+    ("goal", "start", "words"),
+    [
+        ((5.0, 2.0), (2.0, 2.0), "goal (5.00, 2.00) is inside an obstacle"),
+        ((4.5, 2.0), (2.0, 2.0), "goal (4.50, 2.00) is closer than robot_radius"),
+        ((12.0, 2.0), (2.0, 2.0), "goal (12.00, 2.00) is outside the map [0.00, 10.00]"),
+        ((8.0, 2.0), (0.1, 2.0), "start (0.10, 2.00) is closer than robot_radius"),
+        ((8.0, 2.0), (5.0, 2.0), "start (5.00, 2.00) is inside an obstacle"),
+        ((math.nan, 2.0), (2.0, 2.0), "not finite"),
+    ],
+)
+def test_impossible_goals_and_starts_are_named(goal, start, words):
+    result = make(seed=1).plan(wall_map(), (*start, 0.0), (*goal, 0.0))
+    assert not result.ok and words in result.reason
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"state_space": "SE3"}, "state_space"),
+        ({"planner": "Astar"}, "planner"),
+        ({"planner": "FMT", "state_space": "Dubins"}, "FMT"),
+        ({"planner": "AORRTC", "state_space": "Dubins"}, "symmetric"),
+        ({"planner": "PRMstar", "state_space": "Dubins"}, "symmetric"),
+        ({"solve_time": 0.0}, "solve_time"),
+        ({"turning_radius": math.nan}, "turning_radius"),
+        ({"seed": -1}, "seed"),
+        ({"obstacle_cost": 300}, "obstacle_cost"),
+        ({"planner": "PRM", "max_iterations": 10}, "second thread"),
+    ],
+)
+def test_bad_parameters_are_named(kwargs, words):
+    with pytest.raises(ValueError, match=words):
+        OMPLGridPlanner(**kwargs)
+
+
+def test_every_planner_offered_finds_a_path_in_se2():
+    costmap = wall_map()
+    for name in PLANNERS:
+        planner = OMPLGridPlanner(planner=name, **bounded(name), seed=3)
+        result = planner.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, 0.0))
+        assert result.ok, f"{name}: {result.reason}"
+        assert_clear(costmap, result.poses, 0.4)
