@@ -65,6 +65,9 @@ def main(argv: list[str]) -> int:
         "",
         f"- date: {started:%Y-%m-%d %H:%M} UTC; Python {platform.python_version()}; "
         f"speed-up x{args.speed_up:g}; runs kept in {work}",
+        "- this run: "
+        + ("the covering slice only (`--slice`)" if args.slice else "every combination")
+        + f", worlds {args.worlds}: {len(combos)} runs",
     ])
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     Path(args.output).write_text(markdown(outcomes, header))
