@@ -18,6 +18,9 @@ from easynav.playground.sim.world import World
 WORLDS_DIR = Path(str(resources.files("easynav.playground") / "worlds"))
 #: Keys of a moving-obstacle entry that make it a :class:`ScriptedObstacle`.
 _SCRIPT_KEYS = {"start_time", "start_distance", "repeat", "pause"}
+#: Keys of a world's ``imu`` and ``gnss`` sections (playground parameters ``imu.*``, ``gnss.*``).
+_IMU_KEYS = {"rate", "gyro_noise", "gyro_bias", "accel_noise", "yaw_noise"}
+_GNSS_KEYS = {"rate", "noise", "jump_probability", "jump_distance", "outages"}
 
 
 @dataclass
@@ -41,6 +44,10 @@ class WorldDescription:
           radius: 0.15
           limits: {max_linear_vel: 0.3}
           laser: {max_range: 3.5}
+        geodetic_origin: [40.28, -3.82, 746.0]  # optional: lat, lon, alt of the map origin
+        imu: {rate: 50.0, gyro_bias: 0.002}     # optional: the robot has an IMU (imu.* params)
+        gnss: {rate: 5.0, noise: 0.2, outages: [[60, 75]]}  # optional: a GNSS receiver
+                                                # (gnss.* params; needs geodetic_origin)
         furniture:                     # optional: boxes with a height range (BoxObstacle)
           - {name: low shelf, box: [7.5, 3.0, 8.5, 3.4], z: [0.3, 0.4]}
 
@@ -54,7 +61,26 @@ class WorldDescription:
     waypoints_path: Path | None = None
     source: str = ""
     robot: RobotDescription = field(default_factory=RobotDescription)
+    geodetic_origin: tuple[float, float, float] | None = None
+    imu: dict | None = None
+    gnss: dict | None = None
     furniture: list[BoxObstacle] = field(default_factory=list)
+
+    def sensor_parameter_defaults(self) -> dict[str, object]:
+        """Playground parameter defaults of this world's IMU and GNSS (``imu.enabled``,
+        ``imu.rate``, ``gnss.noise``, ``gnss.outages`` flattened to ``[s0, e0, s1, e1...]``)."""
+        values: dict[str, object] = {}
+        for name, spec in (("imu", self.imu), ("gnss", self.gnss)):
+            if spec is None:
+                continue
+            values[f"{name}.enabled"] = True
+            for key, value in spec.items():
+                if key == "outages":
+                    value = [float(v) for window in value for v in window]
+                values[f"{name}.{key}"] = value
+        if self.geodetic_origin is not None:
+            values["geodetic_origin"] = list(self.geodetic_origin)
+        return values
 
     def make_obstacles(self) -> list[MovingObstacle]:
         """Fresh :class:`MovingObstacle` objects (at their first waypoint); a
@@ -143,7 +169,8 @@ class WorldDescription:
         if not isinstance(data, dict) or "map" not in data:
             raise ValueError(f"{path}: a world description needs a 'map' key")
         unknown = set(data) - {
-            "map", "start_pose", "waypoints", "moving_obstacles", "robot", "furniture"
+            "map", "start_pose", "waypoints", "moving_obstacles", "robot", "furniture",
+            "geodetic_origin", "imu", "gnss",
         }
         if unknown:
             raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
@@ -164,6 +191,23 @@ class WorldDescription:
             if "robot" in data
             else RobotDescription()
         )
+        origin = data.get("geodetic_origin")
+        if origin is not None:
+            if not (isinstance(origin, list) and len(origin) == 3
+                    and all(isinstance(v, (int, float)) and math.isfinite(v) for v in origin)):
+                raise ValueError(f"{path}: geodetic_origin must be [lat, lon, alt], got {origin!r}")
+            origin = tuple(float(v) for v in origin)
+        sensors = {}
+        for name, allowed in (("imu", _IMU_KEYS), ("gnss", _GNSS_KEYS)):
+            spec = data.get(name)
+            if spec is None:
+                continue
+            if not isinstance(spec, dict) or set(spec) - allowed:
+                raise ValueError(f"{path}: {name} must be a mapping with keys among "
+                                 f"{sorted(allowed)}, got {spec!r}")
+            sensors[name] = spec
+        if "gnss" in sensors and origin is None:
+            raise ValueError(f"{path}: gnss needs a geodetic_origin")
         furniture = data.get("furniture") or []
         if not isinstance(furniture, list):
             raise ValueError(f"{path}: furniture must be a list")
@@ -179,6 +223,9 @@ class WorldDescription:
             waypoints_path=path.parent / waypoints if waypoints else None,
             source=str(path),
             robot=robot,
+            geodetic_origin=origin,
+            imu=sensors.get("imu"),
+            gnss=sensors.get("gnss"),
             furniture=boxes,
         )
 

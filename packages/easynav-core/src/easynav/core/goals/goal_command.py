@@ -1,5 +1,8 @@
 """``easynav goal X Y [YAW]``: send one goal to a running EasyNav and follow it to the end.
 
+``easynav goal --latlon LAT LON [YAW] --origin LAT0 LON0``: the goal given in latitude and
+longitude, converted to the map frame whose geodetic origin is ``(LAT0, LON0)``.
+
 Exit codes: 0 navigation finished; 1 it did not (rejected, failed or aborted, cancelled by
 someone else, protocol error), the reason on stderr; 2 bad arguments; 3 no goal manager found;
 4 ``--timeout`` expired (the goal is cancelled); 130 interrupted by Ctrl-C (the goal is
@@ -45,11 +48,22 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 finished, 1 not finished (reason printed), 2 bad arguments, "
         "3 no goal manager, 4 timeout, 130 Ctrl-C. Arguments after --ros-args go to ROS.",
     )
-    parser.add_argument("x", type=float, help="goal x (m) in --frame")
-    parser.add_argument("y", type=float, help="goal y (m) in --frame")
+    parser.add_argument("x", type=float, help="goal x (m) in --frame (latitude with --latlon)")
+    parser.add_argument("y", type=float, help="goal y (m) in --frame (longitude with --latlon)")
     parser.add_argument("yaw", type=float, nargs="?", default=0.0, help="goal yaw (rad), 0")
     parser.add_argument("--frame", default="map", help="frame of the goal (default: map)")
     parser.add_argument("--namespace", default="", help="EasyNav's namespace (default: none)")
+    parser.add_argument(
+        "--latlon", action="store_true",
+        help="X Y are latitude and longitude (degrees, WGS 84): the goal is that point in the "
+        "map frame, whose geodetic origin --origin gives (UTM of the origin's zone, x east, "
+        "y north; needs easynav-localizers[gps])",
+    )
+    parser.add_argument(
+        "--origin", type=float, nargs=2, metavar=("LAT", "LON"), default=None,
+        help="geodetic origin of the map frame, for --latlon (the localizer's "
+        "latitude_origin/longitude_origin)",
+    )
     parser.add_argument(
         "--timeout", type=float, default=None,
         help="give up (and cancel the goal) after this many seconds (default: wait forever)",
@@ -92,6 +106,14 @@ def goal_command(
     if problem:
         print(f"easynav goal: error: {problem}", file=err)
         return EXIT_USAGE
+    if args.latlon:
+        try:
+            lat, lon = args.x, args.y
+            args.x, args.y = latlon_to_map(lat, lon, args.origin)
+        except ImportError as exc:
+            print(f"easynav goal: error: {exc}", file=err)
+            return EXIT_USAGE
+        print(f"Goal ({lat:.8f}, {lon:.8f}) is ({args.x:.3f}, {args.y:.3f}) in 'map'", file=out)
 
     own_context = context is None
     if own_context:
@@ -129,7 +151,35 @@ def _check_arguments(args: argparse.Namespace) -> str | None:
         return f"--connect-timeout must be a positive number of seconds, got {args.connect_timeout}"
     if not args.frame:
         return "--frame must not be empty"
+    if args.latlon:
+        if args.origin is None:
+            return "--latlon needs --origin LAT LON (the map frame's geodetic origin)"
+        for name, value, limit in (("latitude", args.x, 90.0), ("longitude", args.y, 180.0),
+                                   ("--origin latitude", args.origin[0], 90.0),
+                                   ("--origin longitude", args.origin[1], 180.0)):
+            if not (math.isfinite(value) and abs(value) <= limit):
+                return f"{name} must be within ±{limit:g} degrees, got {value}"
+        if args.frame != "map":
+            return "--latlon goals are in the map frame (leave --frame out)"
+    elif args.origin is not None:
+        return "--origin is only for --latlon"
     return None
+
+
+def latlon_to_map(
+    latitude: float, longitude: float, origin: Sequence[float]
+) -> tuple[float, float]:
+    """Map-frame ``(x, y)`` of a geodetic point, the map origin at ``origin`` ``(lat, lon)``:
+    UTM (pyproj, the origin's zone) minus the origin's UTM, as the GNSS localizers compute.
+
+    Raises ImportError naming the package when the geodesy is not installed.
+    """
+    try:
+        from easynav.localizers.fusion.utm_projection import UtmProjection
+    except ImportError as exc:
+        raise ImportError("easynav goal --latlon needs pyproj: "
+                          "pip install easynav-localizers[gps]") from exc
+    return UtmProjection(float(origin[0]), float(origin[1])).forward(latitude, longitude)
 
 
 def _run(args, node, executor, client: GoalManagerClient, out: TextIO, err: TextIO) -> int:

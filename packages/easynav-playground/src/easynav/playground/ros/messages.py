@@ -9,7 +9,7 @@ import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import Imu, LaserScan, NavSatFix
 
 from easynav.core.ros.converters import time_to_msg
 from easynav.playground.sim.laser_scanner import LaserScanner
@@ -100,4 +100,48 @@ def occupancy_grid_msg(world: World, stamp: float, frame: str) -> OccupancyGrid:
     msg.info.origin.orientation.w = 1.0
     data = np.where(world.occupied, 100, 0).astype(np.int8)
     msg.data = array.array("b", data.tobytes())
+    return msg
+
+
+def imu_msg(reading, frame: str):
+    """A sensor_msgs/Imu of an :class:`~easynav.playground.sim.imu_sensor.ImuReading`
+    (orientation: the reported heading; covariances from the declared standard deviations,
+    orientation covariance -1 when the heading is off)."""
+    msg = Imu()
+    msg.header.stamp = stamp_msg(reading.stamp)
+    msg.header.frame_id = frame
+    msg.orientation.z = math.sin(0.5 * reading.yaw)
+    msg.orientation.w = math.cos(0.5 * reading.yaw)
+    if reading.yaw_std > 0.0:
+        msg.orientation_covariance = [0.0] * 9
+        msg.orientation_covariance[0] = msg.orientation_covariance[4] = 1e-4
+        msg.orientation_covariance[8] = float(reading.yaw_std**2)
+    else:
+        msg.orientation_covariance = [-1.0] + [0.0] * 8
+    wx, wy, wz = reading.angular_velocity
+    msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = wx, wy, wz
+    msg.angular_velocity_covariance = list(np.diag([max(reading.gyro_std, 1e-6) ** 2] * 3)
+                                           .ravel())
+    ax, ay, az = reading.linear_acceleration
+    msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = ax, ay, az
+    msg.linear_acceleration_covariance = list(np.diag([max(reading.accel_std, 1e-6) ** 2] * 3)
+                                              .ravel())
+    return msg
+
+
+def nav_sat_fix_msg(fix, frame: str):
+    """A sensor_msgs/NavSatFix of a :class:`~easynav.playground.sim.gnss_receiver.GnssFix`
+    (diagonal-known covariance from the declared noise; NO_FIX with NaN coordinates in an
+    outage)."""
+    from sensor_msgs.msg import NavSatStatus
+
+    msg = NavSatFix()
+    msg.header.stamp = stamp_msg(fix.stamp)
+    msg.header.frame_id = frame
+    msg.status.status = NavSatStatus.STATUS_FIX if fix.status >= 0 else NavSatStatus.STATUS_NO_FIX
+    msg.status.service = NavSatStatus.SERVICE_GPS
+    msg.latitude, msg.longitude, msg.altitude = fix.latitude, fix.longitude, fix.altitude
+    variance = float(max(fix.std, 0.01) ** 2)
+    msg.position_covariance = [variance, 0.0, 0.0, 0.0, variance, 0.0, 0.0, 0.0, 4 * variance]
+    msg.position_covariance_type = NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN
     return msg

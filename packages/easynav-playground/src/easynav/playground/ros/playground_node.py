@@ -22,6 +22,8 @@ from easynav.playground.sim import (
     BaseLimits,
     Collision,
     DiffDriveRobot,
+    GnssReceiver,
+    ImuSensor,
     LaserScanner,
     Lidar3D,
     Simulation,
@@ -84,6 +86,22 @@ DEFAULT_PARAMETERS: dict[str, object] = {
     "base.max_linear_decel": 3.0,
     "base.max_angular_acc": 6.0,
     "base.max_angular_decel": 8.0,
+    # Outdoor sensors (on in worlds that declare them: see WorldDescription).
+    "geodetic_origin": [math.nan, math.nan, math.nan],
+    "imu_frame": "imu_link",
+    "gnss_frame": "gps_link",
+    "imu.enabled": False,
+    "imu.rate": 50.0,
+    "imu.gyro_noise": 0.005,
+    "imu.gyro_bias": 0.002,
+    "imu.accel_noise": 0.05,
+    "imu.yaw_noise": 0.02,
+    "gnss.enabled": False,
+    "gnss.rate": 5.0,
+    "gnss.noise": 0.3,
+    "gnss.jump_probability": 0.0,
+    "gnss.jump_distance": 30.0,
+    "gnss.outages": [0.0, 0.0],
 }
 
 _RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
@@ -123,7 +141,11 @@ class PlaygroundNode(Node):
         self.description = WorldDescription.resolve(str(p("world")))
         # The world's robot (radius, base limits, laser) replaces the defaults; a parameter
         # given explicitly (an override) still wins over both.
-        defaults = {**DEFAULT_PARAMETERS, **self.description.robot.parameter_defaults()}
+        defaults = {
+            **DEFAULT_PARAMETERS,
+            **self.description.robot.parameter_defaults(),
+            **self.description.sensor_parameter_defaults(),
+        }
         for name, default in defaults.items():
             if not self.has_parameter(name):
                 self.declare_parameter(name, default)
@@ -138,8 +160,9 @@ class PlaygroundNode(Node):
         if any(math.isnan(v) for v in start):
             start = list(self.description.start_pose)
         self.start_pose = tuple(start)
-        rng_scan, rng_odom, rng_lidar = (
-            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
+        # Children by index: adding sensors at the end leaves the earlier streams unchanged.
+        rng_scan, rng_odom, rng_lidar, rng_imu, rng_gnss = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(5)
         )
         limits = BaseLimits(**{k: float(p(f"base.{k}")) for k in BaseLimits.__slots__})
         robot = DiffDriveRobot(*self.start_pose, limits=limits, cmd_timeout=float(p("cmd_timeout")))
@@ -231,6 +254,34 @@ class PlaygroundNode(Node):
         self._warned_lateral = False
         self._rejected_commands = 0
 
+        self.imu = None
+        self.gnss = None
+        if p("imu.enabled"):
+            self.imu = ImuSensor(
+                rate=float(p("imu.rate")), gyro_noise=float(p("imu.gyro_noise")),
+                gyro_bias=float(p("imu.gyro_bias")), accel_noise=float(p("imu.accel_noise")),
+                yaw_noise=float(p("imu.yaw_noise")), rng=rng_imu)
+            self._imu_pub = self.create_publisher(messages.Imu, "imu/data", _RELIABLE)
+            self.sim.add_periodic(self.imu.period, self._publish_imu)
+        if p("gnss.enabled"):
+            origin = [float(v) for v in p("geodetic_origin")]
+            if len(origin) != 3 or not all(math.isfinite(v) for v in origin):
+                raise ValueError(f"playground: gnss needs geodetic_origin [lat, lon, alt], got "
+                                 f"{origin}")
+            flat = [float(v) for v in p("gnss.outages")]
+            if len(flat) % 2:
+                raise ValueError(f"playground: gnss.outages must be [start, end, ...] pairs, "
+                                 f"got {flat}")
+            self.gnss = GnssReceiver(
+                origin, rate=float(p("gnss.rate")), noise=float(p("gnss.noise")),
+                jump_probability=float(p("gnss.jump_probability")),
+                jump_distance=float(p("gnss.jump_distance")),
+                outages=[flat[i:i + 2] for i in range(0, len(flat), 2)], rng=rng_gnss)
+            self._gnss_pub = self.create_publisher(messages.NavSatFix, "gps/fix", _RELIABLE)
+            self.sim.add_periodic(self.gnss.period, self._publish_gnss)
+        self.frames["imu_frame"] = str(p("imu_frame"))
+        self.frames["gnss_frame"] = str(p("gnss_frame"))
+
         self.sim.on_scan.append(self._publish_scan)
         self.sim.on_cloud.append(self._publish_cloud)
         self.sim.on_odometry.append(self._publish_odometry)
@@ -275,6 +326,10 @@ class PlaygroundNode(Node):
                     self.sim.laser_offset[2],
                 ),
             ]
+            # The outdoor sensors sit on the base (only in worlds that have them).
+            + [messages.planar_transform_msg(0.0, f["robot_frame"], f[frame], 0.0, 0.0)
+               for frame, sensor in (("imu_frame", self.imu), ("gnss_frame", self.gnss))
+               if sensor is not None]
         )
         self._world_pub.publish(
             messages.occupancy_grid_msg(self.description.world, 0.0, f["map_frame"])
@@ -380,6 +435,16 @@ class PlaygroundNode(Node):
                 (robot.v, robot.w),
             )
         )
+
+    def _publish_imu(self, stamp: float) -> None:
+        robot = self.sim.robot
+        reading = self.imu.sample(stamp, robot.yaw, robot.v, robot.w)
+        self._imu_pub.publish(messages.imu_msg(reading, self.frames["imu_frame"]))
+
+    def _publish_gnss(self, stamp: float) -> None:
+        robot = self.sim.robot
+        fix = self.gnss.fix(stamp, robot.x, robot.y)
+        self._gnss_pub.publish(messages.nav_sat_fix_msg(fix, self.frames["gnss_frame"]))
 
     def _publish_collision(self, collision: Collision) -> None:
         count = len(self.sim.checker.collisions)

@@ -5,7 +5,9 @@ from easynav.playground.sim.box_obstacle import BoxObstacle, rasterize_boxes
 from easynav.playground.sim.collision import Collision
 from easynav.playground.sim.collision_checker import CollisionChecker
 from easynav.playground.sim.diff_drive_robot import DiffDriveRobot, integrate_unicycle
+from easynav.playground.sim.gnss_receiver import GnssFix, GnssReceiver
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
+from easynav.playground.sim.imu_sensor import ImuReading, ImuSensor
 from easynav.playground.sim.laser_scanner import LaserScanner
 from easynav.playground.sim.lidar_3d import Lidar3D
 from easynav.playground.sim.moving_obstacle import MovingObstacle
@@ -21,7 +23,11 @@ __all__ = [
     "Collision",
     "CollisionChecker",
     "DiffDriveRobot",
+    "GnssFix",
+    "GnssReceiver",
     "GroundTruthRecorder",
+    "ImuReading",
+    "ImuSensor",
     "LaserScanner",
     "Lidar3D",
     "MovingObstacle",

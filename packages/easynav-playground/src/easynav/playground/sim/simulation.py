@@ -114,6 +114,8 @@ class Simulation:
         self.commands_received = 0
         self._next_scan = scanner.period
         self._next_odom = self.odom_period
+        # Further sensors (IMU, GNSS): [period, next due, callback(stamp)].
+        self._periodic: list[list] = []
         what = self.checker.colliding_with(robot.x, robot.y, self.obstacles)
         if what is not None:
             raise ValueError(
@@ -145,6 +147,17 @@ class Simulation:
         """Whether the robot is held in place."""
         with self._command_lock:
             return self._held
+
+    def add_periodic(self, period: float, callback: StampCallback) -> None:
+        """Call ``callback(stamp)`` every ``period`` simulated seconds, after the step's motion
+        (a sensor reading the robot's state: IMU, GNSS).
+
+        Raises:
+            ValueError: a period not finite and > 0.
+        """
+        if not (math.isfinite(period) and period > 0.0):
+            raise ValueError(f"Simulation: a period must be finite and > 0, got {period}")
+        self._periodic.append([float(period), float(period), callback])
 
     # ------------------------------------------------------------------ state
     def laser_pose(self) -> tuple[float, float, float]:
@@ -225,6 +238,10 @@ class Simulation:
             )
             for cb in self.on_odometry:
                 cb(stamp)
+        for entry in self._periodic:
+            if stamp + eps >= entry[1]:
+                entry[1] = _next_due(entry[1], entry[0], stamp)
+                entry[2](stamp)
         if stamp + eps >= self._next_scan:
             self._next_scan = _next_due(self._next_scan, self.scanner.period, stamp)
             ranges = self.scan_now()

@@ -1,0 +1,114 @@
+"""GpsPoseEstimator: the GPS localizer's algorithm (UTM position, complementary-filtered yaw)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from easynav.core.sensors import GNSSPerception, ImuPerception
+from easynav.core.sensors.gnss_perception import COVARIANCE_TYPE_DIAGONAL_KNOWN
+from easynav.localizers.fusion.fusion_filter import quaternion_to_rpy
+from easynav.localizers.fusion.utm_projection import UtmProjection
+
+#: The original's weights: 0.99 on the gyro-integrated yaw, 0.01 on the IMU's own yaw.
+GYRO_WEIGHT = 0.99
+#: Variance of a position whose fix has no covariance, and of an IMU yaw without one.
+UNKNOWN_VARIANCE = 1.0
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class GpsPoseEstimator:
+    """Position from GNSS, yaw from an IMU, as the original GpsLocalizer, with its gaps filled.
+
+    - Position: UTM(fix) − UTM(first fix) (the first fix's zone, no altitude), plus
+      ``(x0, y0)`` when an initial pose is given (the first fix lands there). Its covariance is
+      the fix's (diagonal known or full), else :data:`UNKNOWN_VARIANCE` per axis.
+    - Yaw: a complementary filter, ``yaw ← 0.99·(yaw + ω_z·dt) + 0.01·yaw_IMU``. The original
+      integrated the raw gyro and never fed the filtered value back (so its yaw drifted with the
+      gyro bias); here the filtered yaw is the integrator's state. Its variance follows the same
+      recursion, ``σ² ← 0.99²·(σ² + σ_ω²·dt²) + 0.01²·σ²_IMU``. Roll and pitch are the IMU's.
+
+    Raises ImportError naming the extra without pyproj. Thread contract: none (the plugin
+    serialises calls).
+    """
+
+    def __init__(self, x0: float = 0.0, y0: float = 0.0, yaw0: float = 0.0) -> None:
+        self.offset = np.array((x0, y0))
+        self.projection: UtmProjection | None = None
+        self.position: np.ndarray | None = None
+        self.position_covariance = np.eye(2) * UNKNOWN_VARIANCE
+        self.yaw = yaw0
+        self.yaw_variance = UNKNOWN_VARIANCE
+        self.roll = 0.0
+        self.pitch = 0.0
+        self.angular_velocity = np.zeros(3)
+        self._yaw_initialised = False
+        self._imu_stamp: float | None = None
+        self.stamp = 0.0
+
+    def add_fix(self, fix: GNSSPerception) -> bool:
+        """Take a fix; False when it has none (ignored)."""
+        if not fix.has_fix:
+            return False
+        if self.projection is None:
+            self.projection = UtmProjection(fix.latitude, fix.longitude, fix.altitude)
+        east, north = self.projection.forward(fix.latitude, fix.longitude)
+        self.position = np.array((east, north)) + self.offset
+        cov = np.asarray(fix.position_covariance, dtype=float).reshape(3, 3)
+        if fix.position_covariance_type >= COVARIANCE_TYPE_DIAGONAL_KNOWN and np.all(
+            np.isfinite(cov)
+        ):
+            self.position_covariance = cov[:2, :2].copy()
+        else:
+            self.position_covariance = np.eye(2) * UNKNOWN_VARIANCE
+        self.stamp = max(self.stamp, fix.stamp)
+        return True
+
+    def add_imu(self, imu: ImuPerception) -> None:
+        """Take an IMU reading: roll and pitch, and one step of the yaw filter."""
+        imu_yaw = None
+        var_imu = UNKNOWN_VARIANCE
+        if imu.has_orientation:
+            self.roll, self.pitch, imu_yaw = quaternion_to_rpy(*imu.orientation)
+            var_imu = float(imu.orientation_covariance[2, 2]) or UNKNOWN_VARIANCE
+        if not self._yaw_initialised:
+            if imu_yaw is not None:
+                self.yaw, self.yaw_variance = imu_yaw, var_imu
+                self._yaw_initialised = True
+            self._imu_stamp = imu.stamp
+            return
+        dt = 0.0 if self._imu_stamp is None else max(0.0, imu.stamp - self._imu_stamp)
+        self._imu_stamp = imu.stamp
+        wz = float(imu.angular_velocity[2]) if imu.has_angular_velocity else 0.0
+        var_w = float(imu.angular_velocity_covariance[2, 2]) if imu.has_angular_velocity else 0.0
+        self.angular_velocity = np.asarray(imu.angular_velocity, dtype=float).copy()
+        predicted = self.yaw + wz * dt
+        variance = self.yaw_variance + var_w * dt * dt
+        if imu_yaw is None:
+            self.yaw, self.yaw_variance = _wrap(predicted), variance
+        else:
+            g = GYRO_WEIGHT
+            self.yaw = _wrap(predicted + (1.0 - g) * _wrap(imu_yaw - predicted))
+            self.yaw_variance = g * g * variance + (1.0 - g) ** 2 * var_imu
+        self.stamp = max(self.stamp, imu.stamp)
+
+    def reset(self, x: float, y: float, yaw: float) -> None:
+        """Move the estimate to ``(x, y, yaw)``: later fixes are shifted to agree."""
+        if self.position is not None:
+            self.offset += np.array((x, y)) - self.position
+            self.position = np.array((x, y))
+        else:
+            self.offset = np.array((x, y))
+        self.yaw = yaw
+        self._yaw_initialised = True
+
+    def covariance6(self) -> np.ndarray:
+        """6×6 pose covariance (x, y, z, roll, pitch, yaw): z, roll, pitch unknown (1.0)."""
+        cov = np.eye(6) * UNKNOWN_VARIANCE
+        cov[:2, :2] = self.position_covariance
+        cov[5, 5] = self.yaw_variance
+        return cov

@@ -1,0 +1,208 @@
+"""GpsLocalizer (easynav_gps_localizer/GpsLocalizer): pose from GNSS and an IMU."""
+
+from __future__ import annotations
+
+import threading
+from typing import Any, ClassVar
+
+import numpy as np
+
+from easynav.core.nav_state import NavState
+from easynav.core.nav_state_keys import ROBOT_POSE
+from easynav.core.plugins import LocalizerMethodBase, Param, Topic
+from easynav.core.sensors import GNSSPerception, ImuPerception
+from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import (
+    Header,
+    Odometry,
+    Pose,
+    Transform,
+    TransformStamped,
+    Twist,
+)
+from easynav.localizers.gps.gps_pose_estimator import GpsPoseEstimator
+
+#: The original's fixed topics (relative; not parameters, not through the sensors node).
+FIX_TOPIC = "robot/gps/fix"
+IMU_TOPIC = "imu/data"
+ODOM_TOPIC = "robot/odom_gps"
+
+_STATIC = {"dynamic": False}
+
+
+def _rpy_quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
+    import math
+
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+class GpsLocalizer(LocalizerMethodBase):
+    """The original GPS localizer, with a covariance and the filtered yaw fed back.
+
+    Position: UTM of each fix minus UTM of the first (pyproj, the first fix's zone; no
+    altitude), shifted so the first fix lands on ``initial_pose.x/.y`` when set. Yaw: a
+    complementary filter of the IMU's gyro and orientation (see :class:`GpsPoseEstimator`);
+    roll and pitch from the IMU. ``robot_pose`` carries a covariance (the fix's, the yaw
+    filter's) and the IMU's angular velocity as twist.
+
+    NavState: writes ``robot_pose`` in ``update`` (non-RT; ``update_rt`` does nothing, as the
+    original). ROS: subscribes ``robot/gps/fix`` (NavSatFix) and ``imu/data`` (Imu) with
+    sensor-data QoS made reliable; publishes ``robot/odom_gps`` (Odometry); broadcasts a static
+    identity ``map → odom``; ``initialpose`` moves the estimate (later fixes shifted to agree).
+    Without ROS, :meth:`add_fix` and :meth:`add_imu` feed it.
+
+    Thread contract: subscription callbacks and ``update`` on the non-RT side; one lock guards
+    the estimator. Exceptions: ImportError naming the extra without pyproj (at the first fix);
+    a bad message is dropped with a throttled warning.
+    """
+
+    NEEDS_MAPS: ClassVar[tuple[str, ...]] = ()
+    HAS_RT_UPDATE = False
+    PARAMETERS = (
+        Param("initial_pose.x", 0.0, "where the first fix lands: x (map frame)", "m", **_STATIC),
+        Param("initial_pose.y", 0.0, "where the first fix lands: y (map frame)", "m", **_STATIC),
+        Param("initial_pose.yaw", 0.0, "unused (yaw comes from the IMU), as the original", "rad",
+              **_STATIC),
+    )
+    TOPICS = LocalizerMethodBase.TOPICS + (
+        Topic(FIX_TOPIC, "sensor_msgs/msg/NavSatFix", "sub", "sensor data, reliable",
+              "GNSS fixes"),
+        Topic(IMU_TOPIC, "sensor_msgs/msg/Imu", "sub", "sensor data, reliable",
+              "orientation and gyro"),
+        Topic(ODOM_TOPIC, "nav_msgs/msg/Odometry", "pub", description="the estimate"),
+        Topic("tf_static", "tf2_msgs/msg/TFMessage", "pub", description="map → odom identity"),
+    )
+    WRITES = (ROBOT_POSE,)
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._lock = threading.Lock()
+        self._throttle = WarningThrottle(period=5.0)
+        self.estimator = GpsPoseEstimator()
+        self._ros: dict[str, Any] = {}
+        self._static = None
+
+    def on_initialize(self) -> None:
+        self._destroy_ros()
+        v = self.params
+        with self._lock:
+            self.estimator = GpsPoseEstimator(v["initial_pose.x"], v["initial_pose.y"])
+        if self.context.node is not None:
+            self._create_ros()
+        else:
+            self._send_identity()
+
+    def on_cleanup(self) -> None:
+        self._destroy_ros()
+
+    # -- inputs --------------------------------------------------------------------------------
+    def add_fix(self, fix: GNSSPerception) -> None:
+        """A GNSS fix (ignored without a fix). Any thread."""
+        with self._lock:
+            self.estimator.add_fix(fix)
+
+    def add_imu(self, imu: ImuPerception) -> None:
+        """An IMU reading. Any thread."""
+        if not np.all(np.isfinite(imu.orientation)):
+            self._throttle.warn(self.logger, "imu-nan", f"{self.plugin_name}: non-finite IMU")
+            return
+        with self._lock:
+            self.estimator.add_imu(imu)
+
+    def on_last_known_pose(self, pose: Odometry) -> None:
+        """Continue from ``pose``: later fixes are shifted so it holds."""
+        with self._lock:
+            self.estimator.reset(pose.pose.x, pose.pose.y, pose.pose.yaw)
+
+    # -- cycle ---------------------------------------------------------------------------------
+    def update_rt(self, nav_state: NavState) -> None:
+        """Nothing (the original's ``update_rt`` is empty)."""
+
+    def update(self, nav_state: NavState) -> None:
+        """Write ``robot_pose`` from the last fix and IMU reading (once a fix arrived)."""
+        with self._lock:
+            e = self.estimator
+            if e.position is None:
+                self._throttle.warn(self.logger, "no-fix", f"{self.plugin_name}: no GNSS fix yet")
+                return
+            qx, qy, qz, qw = _rpy_quaternion(e.roll, e.pitch, e.yaw)
+            tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+            odometry = Odometry(
+                header=Header(e.stamp, tf_info.map_frame),
+                child_frame_id=tf_info.robot_footprint_frame,
+                pose=Pose(float(e.position[0]), float(e.position[1]), 0.0, qx, qy, qz, qw),
+                pose_covariance=e.covariance6(),
+                twist=Twist(wx=e.angular_velocity[0], wy=e.angular_velocity[1],
+                            wz=e.angular_velocity[2]),
+            )
+        nav_state.set(ROBOT_POSE, odometry)
+        publisher = self._ros.get("odom")
+        if publisher is not None:
+            from easynav.core.ros.converters import odometry_to_msg
+
+            publisher.publish(odometry_to_msg(odometry))
+
+    # -- ROS -----------------------------------------------------------------------------------
+    def _identity(self) -> TransformStamped:
+        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        return TransformStamped(Header(0.0, tf_info.map_frame), tf_info.odom_frame,
+                                Transform(np.zeros(3), np.array((0.0, 0.0, 0.0, 1.0))))
+
+    def _send_identity(self) -> None:
+        get_tf_buffer(self.context.namespace).set_transform(self._identity(), self.plugin_name,
+                                                            is_static=True)
+
+    def _create_ros(self) -> None:
+        from nav_msgs.msg import Odometry as OdometryMsg
+        from rclpy.qos import qos_profile_sensor_data
+        from sensor_msgs.msg import Imu, NavSatFix
+
+        from easynav.core.sensors.converters.imu import imu_from_msg
+        from easynav.core.sensors.converters.nav_sat_fix import gnss_from_msg
+        from easynav.core.tf import StaticTFBroadcaster
+
+        node = self.context.node
+        qos = qos_profile_sensor_data
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+        qos = QoSProfile(history=qos.history, depth=qos.depth,
+                         reliability=ReliabilityPolicy.RELIABLE, durability=qos.durability)
+
+        def on_fix(msg):
+            try:
+                self.add_fix(gnss_from_msg(msg))
+            except Exception as exc:  # a callback must not end the executor's spin
+                self._throttle.warn(self.logger, "fix", f"{self.plugin_name}: fix dropped: {exc}")
+
+        def on_imu(msg):
+            try:
+                self.add_imu(imu_from_msg(msg))
+            except Exception as exc:
+                self._throttle.warn(self.logger, "imu", f"{self.plugin_name}: IMU dropped: {exc}")
+
+        self._ros = {
+            "fix": node.create_subscription(NavSatFix, FIX_TOPIC, on_fix, qos),
+            "imu": node.create_subscription(Imu, IMU_TOPIC, on_imu, qos),
+            "odom": node.create_publisher(OdometryMsg, ODOM_TOPIC, 10),
+        }
+        self._static = StaticTFBroadcaster(node, local_buffer=get_tf_buffer(self.context.namespace))
+        self._static.send_transform(self._identity())
+
+    def _destroy_ros(self) -> None:
+        node = self.context.node
+        ros, self._ros = self._ros, {}
+        static, self._static = self._static, None
+        if node is None:
+            return
+        for name, entity in ros.items():
+            if name == "odom":
+                node.destroy_publisher(entity)
+            else:
+                node.destroy_subscription(entity)
+        if static is not None and hasattr(static, "destroy"):
+            static.destroy()

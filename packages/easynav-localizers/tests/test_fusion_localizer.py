@@ -1,0 +1,267 @@
+"""FusionLocalizer without ROS: tracking with GNSS noise, a GNSS outage, a GNSS jump."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("filterpy")
+pytest.importorskip("pyproj")
+
+from easynav.core.nav_state import NavState  # noqa: E402
+from easynav.core.plugins import (  # noqa: E402
+    DictParameters,
+    PluginConfigurationError,
+    PluginContext,
+)
+from easynav.core.sensors import GNSSPerception, ImuPerception  # noqa: E402
+from easynav.core.sensors.gnss_perception import (  # noqa: E402
+    COVARIANCE_TYPE_DIAGONAL_KNOWN,
+    STATUS_FIX,
+)
+from easynav.core.types import Header, Odometry, Pose, Twist, yaw_to_quaternion  # noqa: E402
+from easynav.localizers.fusion.ukf_filter import (  # noqa: E402
+    UkfFilter,
+    transition,
+    transition_batch,
+)
+from easynav.localizers.fusion.utm_projection import UtmProjection  # noqa: E402
+from easynav.localizers.fusion_localizer import ROBOT_POSE_LOCAL, FusionLocalizer  # noqa: E402
+
+_namespaces = itertools.count()
+ORIGIN = (40.2834931, -3.8207254, 746.184)  # the original's example origin
+RATE = 10.0  # odometry and IMU (Hz)
+GNSS_EVERY = 2  # one fix every 2 cycles: 5 Hz
+GNSS_SIGMA = 0.8  # m, per axis
+DURATION = 150.0
+OUTAGE = (60.0, 90.0)
+JUMP = (120.0, 122.0)  # fixes 30 m east in this window
+
+
+def fusion_params(**overrides) -> dict:
+    params = {
+        "Ukf.latitude_origin": ORIGIN[0],
+        "Ukf.longitude_origin": ORIGIN[1],
+        "Ukf.altitude_origin": ORIGIN[2],
+        "Ukf.global_filter.two_d_mode": True,
+        "Ukf.global_filter.odom0": "odom",
+        "Ukf.global_filter.odom0_config": [False] * 6 + [True, True, False,
+                                                         False, False, True] + [False] * 3,
+        "Ukf.global_filter.imu0": "imu/data",
+        "Ukf.global_filter.imu0_config": [False] * 5 + [True] + [False] * 5 + [True]
+        + [False] * 3,
+        "Ukf.global_filter.gps0": "gps/fix",
+        "Ukf.global_filter.gps0_config": [True, True] + [False] * 13,
+        "Ukf.global_filter.gps0_rejection_threshold": 5.0,
+        "Ukf.global_filter.publish_tf": False,  # no odometry TF in these tests
+    }
+    params.update(overrides)
+    return params
+
+
+class Sim:
+    """A robot driving curves for 150 s: wheel odometry with slip (3 % long, yaw-rate bias),
+    an IMU (absolute yaw, gyro with bias), GNSS at 5 Hz with 0.8 m noise, an outage, a jump."""
+
+    def __init__(self, params: dict, seed: int = 0) -> None:
+        self.rng = np.random.default_rng(seed)
+        self.t = 0.0
+        self.true = np.array((0.0, 0.0, 0.3))
+        self.odom = np.array((0.0, 0.0, 0.3))  # dead reckoning, aligned at the start
+        self.projection = UtmProjection(*ORIGIN)
+        namespace = f"fusion_test_{next(_namespaces)}"
+        context = PluginContext(parameters=DictParameters(params), namespace=namespace,
+                                now=lambda: self.t)
+        self.plugin = FusionLocalizer()
+        self.plugin.initialize(context, "Ukf")
+        self.nav_state = NavState()
+        self.log: list[tuple] = []  # t, true xy, estimate xy, odometry xy, last fix xy
+
+    def run(self, duration: float = DURATION, outage=OUTAGE, jump=JUMP) -> np.ndarray:
+        dt = 1.0 / RATE
+        rng = self.rng
+        fix_xy = (math.nan, math.nan)
+        for k in range(int(duration * RATE)):
+            v, w = 1.0, 0.35 * math.sin(2 * math.pi * self.t / 40.0)
+            yaw = self.true[2]
+            self.true += (v * math.cos(yaw) * dt, v * math.sin(yaw) * dt, w * dt)
+            self.t += dt
+            # Wheels: 3 % slip in distance, 0.02 rad/s yaw-rate bias, noise.
+            v_odom = 1.03 * v + rng.normal(0, 0.02)
+            w_odom = w + 0.02 + rng.normal(0, 0.01)
+            oyaw = self.odom[2]
+            self.odom += (v_odom * math.cos(oyaw) * dt, v_odom * math.sin(oyaw) * dt,
+                          w_odom * dt)
+            cov6 = np.diag([0.05**2, 0.01**2, 1e-6, 1e-6, 1e-6, 0.03**2])
+            self.plugin.add_odometry("global_filter", "odom0", Odometry(
+                header=Header(self.t, "odom"), child_frame_id="base_footprint",
+                pose=Pose.from_xy_yaw(*self.odom),
+                twist=Twist(vx=v_odom, wz=w_odom), twist_covariance=cov6))
+            imu_yaw = self.true[2] + rng.normal(0, 0.02)
+            self.plugin.add_imu("global_filter", "imu0", ImuPerception(
+                orientation=np.array(yaw_to_quaternion(imu_yaw)),
+                orientation_covariance=np.eye(3) * 0.02**2,
+                angular_velocity=np.array((0.0, 0.0, w + 0.005 + rng.normal(0, 0.01))),
+                angular_velocity_covariance=np.eye(3) * 0.01**2,
+                linear_acceleration_covariance=-np.eye(3),
+                stamp=self.t))
+            in_outage = outage[0] <= self.t < outage[1]
+            if k % GNSS_EVERY == 0 and not in_outage:
+                fx = self.true[0] + rng.normal(0, GNSS_SIGMA)
+                fy = self.true[1] + rng.normal(0, GNSS_SIGMA)
+                if jump[0] <= self.t < jump[1]:
+                    fx += 30.0
+                fix_xy = (fx, fy)
+                lat, lon = self.projection.inverse(fx, fy)
+                self.nav_state.set("gps", GNSSPerception(
+                    latitude=lat, longitude=lon, altitude=ORIGIN[2],
+                    position_covariance=np.eye(3) * GNSS_SIGMA**2,
+                    position_covariance_type=COVARIANCE_TYPE_DIAGONAL_KNOWN,
+                    status=STATUS_FIX, stamp=self.t))
+                self.nav_state.add_to_group("gnss", "gps")
+            self.plugin.update_rt(self.nav_state)
+            if self.nav_state.has("robot_pose"):
+                pose = self.nav_state.get("robot_pose", Odometry).pose
+                self.log.append((self.t, *self.true[:2], pose.x, pose.y, *self.odom[:2],
+                                 *fix_xy, self.true[2], pose.yaw))
+        return np.array(self.log)
+
+
+@pytest.fixture(scope="module")
+def run() -> tuple[np.ndarray, Sim]:
+    sim = Sim(fusion_params())
+    return sim.run(), sim
+
+
+def _errors(log: np.ndarray, cols: tuple[int, int]) -> np.ndarray:
+    return np.hypot(log[:, cols[0]] - log[:, 1], log[:, cols[1]] - log[:, 2])
+
+
+def test_fusion_beats_odometry_alone_and_gnss_alone(run):
+    log, _ = run
+    window = log[(log[:, 0] >= 5.0) & (log[:, 0] < OUTAGE[0])]  # after settling, before outage
+    fused = np.sqrt(np.mean(_errors(window, (3, 4)) ** 2))
+    odometry = np.sqrt(np.mean(_errors(window, (5, 6)) ** 2))
+    gnss = np.sqrt(np.mean(_errors(window, (7, 8)) ** 2))
+    assert fused < 0.5, fused
+    assert fused < 0.5 * gnss, (fused, gnss)
+    assert fused < odometry, (fused, odometry)
+    # Over the whole run odometry alone drifts far more.
+    assert np.sqrt(np.mean(_errors(log, (5, 6)) ** 2)) > 2.0
+
+
+def test_gnss_outage_bridged_within_one_metre(run):
+    log, _ = run
+    outage = log[(log[:, 0] >= OUTAGE[0]) & (log[:, 0] < OUTAGE[1] + 5.0)]
+    assert OUTAGE[1] - OUTAGE[0] >= 30.0
+    assert _errors(outage, (3, 4)).max() < 1.0
+
+
+def test_gnss_jump_rejected(run):
+    log, sim = run
+    after = log[(log[:, 0] >= JUMP[0]) & (log[:, 0] < JUMP[1] + 3.0)]
+    assert _errors(after, (3, 4)).max() < 1.0
+    assert sim.plugin.filters["global_filter"].rejected["gps0"] >= 5  # 10 jumped fixes (5 Hz, 2 s)
+    yaw_error = np.abs((log[:, 9] - log[:, 10] + math.pi) % (2 * math.pi) - math.pi)
+    assert yaw_error[log[:, 0] > 5.0].max() < 0.1
+
+
+def test_without_gate_the_jump_pulls_the_estimate():
+    params = fusion_params()
+    del params["Ukf.global_filter.gps0_rejection_threshold"]
+    log = Sim(params).run(duration=JUMP[1] + 1.0, outage=(0.0, 0.0))
+    during = log[(log[:, 0] >= JUMP[0]) & (log[:, 0] < JUMP[1] + 1.0)]
+    assert _errors(during, (3, 4)).max() > 3.0
+
+
+def test_local_filter_writes_robot_pose_local():
+    params = {
+        "Ukf.local_filter.two_d_mode": True,
+        # Known start pose, unknown velocities (an unknown yaw would shrink the expected advance).
+        "Ukf.local_filter.initial_estimate_covariance": [1e-9] * 6 + [1.0] * 9,
+        "Ukf.local_filter.odom0": "odom",
+        "Ukf.local_filter.odom0_config": [False] * 6 + [True, False, False,
+                                                        False, False, True] + [False] * 3,
+    }
+    context = PluginContext(parameters=DictParameters(params), namespace="fusion_local")
+    plugin = FusionLocalizer()
+    plugin.initialize(context, "Ukf")
+    assert list(plugin.filters) == ["local_filter"]
+    nav_state = NavState()
+    for k in range(1, 41):  # 2 s at 1 m/s
+        plugin.add_odometry("local_filter", "odom0", Odometry(
+            header=Header(k * 0.05, "odom"), twist=Twist(vx=1.0),
+            twist_covariance=np.eye(6) * 1e-4))
+        plugin.update_rt(nav_state)
+    pose = nav_state.get(ROBOT_POSE_LOCAL, Odometry)
+    assert pose.pose.x == pytest.approx(1.95, abs=0.1)
+    assert not nav_state.has("robot_pose")
+
+
+def test_last_known_pose_moves_the_estimate_and_gnss_agrees(run):
+    sim = Sim(fusion_params(), seed=3)
+    sim.run(duration=10.0, outage=(0.0, 0.0))
+    sim.plugin.on_last_known_pose(Odometry(
+        header=Header(sim.t, "map"), pose=Pose.from_xy_yaw(100.0, 50.0, sim.true[2]),
+        pose_covariance=np.eye(6) * 0.01))
+    log = np.array(sim.run(duration=5.0, outage=(0.0, 0.0)))
+    last = log[-1]
+    # The estimate stays around the new pose: GNSS is shifted, not fighting it.
+    moved = math.hypot(last[3] - last[1] - (100.0 - log[len(log) - 101][1]),
+                       last[4] - last[2] - (50.0 - log[len(log) - 101][2]))
+    assert moved < 5.0
+
+
+def test_configuration_errors_name_the_parameter():
+    context = PluginContext(parameters=DictParameters({}), namespace="fusion_none")
+    with pytest.raises(PluginConfigurationError, match="global_filter"):
+        FusionLocalizer().initialize(context, "Ukf")
+    bad = fusion_params(**{"Ukf.global_filter.gps0_config": [True, True]})
+    context = PluginContext(parameters=DictParameters(bad), namespace="fusion_bad")
+    with pytest.raises(PluginConfigurationError, match="gps0_config"):
+        FusionLocalizer().initialize(context, "Ukf")
+    bad = fusion_params(**{"Ukf.global_filter.process_noise_covariance": [0.1] * 7})
+    context = PluginContext(parameters=DictParameters(bad), namespace="fusion_bad2")
+    with pytest.raises(PluginConfigurationError, match="process_noise_covariance"):
+        FusionLocalizer().initialize(context, "Ukf")
+
+
+def test_original_example_keys_are_known():
+    keys = {
+        "plugin": "easynav_fusion_localizer/FusionLocalizer",
+        "rt_freq": 50.0, "freq": 5.0, "latitude_origin": 40.0,
+        "global_filter.two_d_mode": True, "global_filter.map_frame": "map",
+        "global_filter.gps0": "/gps/fix", "global_filter.gps0_config": [True] * 15,
+        "global_filter.gps0_differential": False,
+        "global_filter.imu0_remove_gravitational_acceleration": True,
+        "global_filter.twist0_config": [False] * 15,
+        "global_filter.process_noise_covariance": [0.0] * 225,
+    }
+    unknown = FusionLocalizer.unknown_parameter_keys(keys)
+    # gps0_differential is not a parameter of a GNSS input here (nor of the original's).
+    assert [k for k, _ in unknown] == ["global_filter.gps0_differential"]
+
+
+def test_ukf_transition_and_wrap():
+    state = np.zeros(15)
+    state[5], state[6], state[11] = math.pi - 0.01, 1.0, 1.0
+    moved = transition(state, 0.1)
+    assert moved[0] == pytest.approx(-0.1, abs=1e-3)
+    assert moved[5] == pytest.approx(-math.pi + 0.09, abs=1e-9)  # wrapped
+    ukf = UkfFilter(two_d_mode=True, initial_covariance=np.eye(15))
+    assert ukf.correct([5], [math.pi - 0.05], [[0.01]])
+    assert ukf.correct([5], [-math.pi + 0.05], [[0.01]])
+    assert abs(abs(ukf.state[5]) - math.pi) < 0.1  # the mean of ±(π-0.05) is π, not 0
+    assert not ukf.correct([0], [100.0], [[0.01]], threshold=3.0)
+    assert ukf.state[0] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_batch_transition_matches_the_reference():
+    rng = np.random.default_rng(1)
+    states = rng.normal(0.0, 1.0, (31, 15))
+    batch = transition_batch(states, 0.07)
+    for row, moved in zip(states, batch, strict=False):
+        np.testing.assert_allclose(moved, transition(row, 0.07), atol=1e-12)
