@@ -46,8 +46,9 @@ AXES = (
     ("planner_node", "planner_types", "planner"),
     ("controller_node", "controller_types", "controller"),
 )
-#: Shipped worlds a combination runs in, by default: the home world and the real maps.
-WORLDS = ("home", "tb3_sandbox", "depot")
+#: Shipped worlds a combination runs in, by default: the home world, the real maps and the
+#: outdoor campus (the only one with a GNSS receiver).
+WORLDS = ("home", "tb3_sandbox", "depot", "campus")
 
 
 @dataclass(frozen=True)
@@ -107,6 +108,25 @@ def plugin_class(kind_name: str, name: str) -> type:
     return load_plugin_class(kind, name, f"matrix.{kind_name.replace(' ', '_')}")
 
 
+def world_sensors(world: str) -> set[str]:
+    """The sensors a shipped world's robot has: a laser always; an IMU and a GNSS receiver
+    where the world declares them."""
+    from easynav.playground.world_description import WorldDescription
+
+    description = WorldDescription.resolve(world)
+    sensors = {"laser"}
+    if description.imu is not None:
+        sensors.add("imu")
+    if description.gnss is not None:
+        sensors.add("gnss")
+    return sensors
+
+
+def needed_sensors(cls: type) -> set[str]:
+    """The sensors a plugin class declares it needs (``NEEDS_SENSORS``)."""
+    return set(getattr(cls, "NEEDS_SENSORS", ()))
+
+
 def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
     """Every compatible combination × world, in a stable order."""
     plugins = navigation_plugins()
@@ -125,6 +145,7 @@ def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
             needs = needed_maps(classes[("maps manager", extra)])
             if needs and compatible(needs, provided_maps(base_cls)):
                 stacks.append((base, extra))
+    sensors_of = {world: world_sensors(world) for world in worlds}
     combos = []
     for stack, loc, plan, ctrl in itertools.product(
         stacks, plugins["localizer"], plugins["planner"], plugins["controller"]
@@ -136,7 +157,15 @@ def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
             for kind, name in (("localizer", loc), ("planner", plan), ("controller", ctrl))
         ):
             continue
-        combos += [Combination(maps, loc, plan, ctrl, world) for world in worlds]
+        needs = set().union(*(
+            needed_sensors(classes[(kind, name)])
+            for kind, name in (("localizer", loc), ("planner", plan), ("controller", ctrl))
+        ))
+        combos += [
+            Combination(maps, loc, plan, ctrl, world)
+            for world in worlds
+            if needs <= sensors_of[world]
+        ]
     return combos
 
 
@@ -172,19 +201,53 @@ def unmatched_plugins(combos: list[Combination]) -> dict[str, str]:
     return reasons
 
 
+def shipped_stacks() -> list[set[str]]:
+    """The plugin sets of the shipped params files (params/): stacks known to be tuned."""
+    stacks = []
+    for path in sorted(PARAMS_DIR.glob("*.yaml")):
+        try:
+            document = load_ros_yaml(path.read_text())
+        except yaml.YAMLError:
+            continue
+        if not isinstance(document, dict):
+            continue
+        plugins = set()
+        for node, types_key, _ in AXES:
+            params = (document.get(node) or {}).get("ros__parameters") or {}
+            for alias in params.get(types_key) or []:
+                section = params.get(alias)
+                if isinstance(section, dict) and "plugin" in section:
+                    plugins.add(section["plugin"])
+        if plugins:
+            stacks.append(plugins)
+    return stacks
+
+
 def covering_slice(combos: list[Combination]) -> list[Combination]:
-    """A few combinations that together use every plugin at least once (greedy set cover;
-    one world per combination, taking the worlds in turn)."""
+    """A few combinations that together use every plugin at least once (greedy set cover).
+
+    Each step takes, among the combinations that use a plugin not yet covered, the one closest
+    to a shipped params file (most plugins in common with one: a tuned stack with one plugin
+    swapped, the way a user swaps one), then the one covering the most new plugins; each in the
+    first of the worlds given that suits it.
+    """
+    stacks = shipped_stacks()
+
+    def familiarity(plugins: tuple[str, ...]) -> int:
+        return max((len(set(plugins) & stack) for stack in stacks), default=0)
+
     by_plugins: dict[tuple[str, ...], list[Combination]] = {}
     for combo in combos:
         by_plugins.setdefault(combo.plugins, []).append(combo)
-    # Each world in turn, so the slice also drives in every world.
     uncovered = {p for combo in combos for p in combo.plugins}
     chosen: list[Combination] = []
     while uncovered:
-        plugins = max(by_plugins, key=lambda ps: (len(set(ps) & uncovered), ps))
-        options = by_plugins[plugins]
-        chosen.append(options[len(chosen) % len(options)])
+        candidates = [ps for ps in by_plugins if set(ps) & uncovered]
+        plugins = max(
+            candidates,
+            key=lambda ps: (familiarity(ps), len(set(ps) & uncovered), -len(ps), ps),
+        )
+        chosen.append(by_plugins[plugins][0])  # the first world given that suits it
         uncovered -= set(plugins)
     return chosen
 

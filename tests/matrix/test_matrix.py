@@ -53,7 +53,7 @@ def test_the_slice_covers_every_plugin():
     combos = combinations()
     chosen = covering_slice(combos)
     assert {p for c in chosen for p in c.plugins} == {p for c in combos for p in c.plugins}
-    assert len(chosen) <= max(len(names) for names in navigation_plugins().values()) + 2
+    assert len(chosen) <= sum(len(names) for names in navigation_plugins().values())
 
 
 def test_composed_params_take_each_plugin_from_its_representative_file():
@@ -72,7 +72,8 @@ def test_composed_params_take_each_plugin_from_its_representative_file():
 
 
 # CI's slice drives in the home world (roomy: every stack's tuning fits it); the full matrix
-# (`make matrix`) adds the real maps.
+# (`make matrix`) adds the real maps and the campus, where the GNSS localizers join (their own
+# campus runs are in easynav-localizers' tests).
 SLICE = covering_slice(combinations(("home",)))
 
 

@@ -97,6 +97,9 @@ class FusionLocalizer(LocalizerMethodBase):
     missing; a bad measurement is dropped with a throttled warning.
     """
 
+    #: Sensors the robot must have (the integration matrix runs it only in worlds that give them).
+    NEEDS_SENSORS = ("gnss",)
+
     NEEDS_MAPS: ClassVar[tuple[str, ...]] = ()
     HAS_UPDATE = False
     PARAMETERS = (

@@ -61,6 +61,9 @@ class GpsLocalizer(LocalizerMethodBase):
     a bad message is dropped with a throttled warning.
     """
 
+    #: Sensors the robot must have (the integration matrix runs it only in worlds that give them).
+    NEEDS_SENSORS = ("gnss",)
+
     NEEDS_MAPS: ClassVar[tuple[str, ...]] = ()
     HAS_RT_UPDATE = False
     PARAMETERS = (

@@ -53,6 +53,9 @@ class GtsamLocalizer(LocalizerMethodBase):
     gtsam or pyproj; PluginConfigurationError for a bad origin.
     """
 
+    #: Sensors the robot must have (the integration matrix runs it only in worlds that give them).
+    NEEDS_SENSORS = ("gnss",)
+
     NEEDS_MAPS: ClassVar[tuple[str, ...]] = ()
     HAS_UPDATE = False
     PARAMETERS = (
