@@ -193,6 +193,11 @@ def unmatched_plugins(combos: list[Combination]) -> dict[str, str]:
                     f"provides {', '.join(sorted(provides)) or 'nothing'}: no installed "
                     f"{' or '.join(missing) or 'plugin'} works on it"
                 )
+            elif needed_sensors(cls):
+                reasons[name] = (
+                    f"needs a {' and '.join(sorted(needed_sensors(cls)))} sensor: none of the "
+                    "worlds run has one"
+                )
             else:
                 reasons[name] = (
                     f"needs {' or '.join(needed_maps(cls))}: its stack lacks a partner of "
