@@ -7,11 +7,12 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 from easynav.core.cli.params_file import ParamsFileError, load_params_file, load_ros_yaml
+from easynav.core.testing.system_fixtures import system_params
 
 EASYNAV = str(Path(sys.executable).with_name("easynav"))
-REPO = Path(__file__).resolve().parents[4]
 
 # As in the original's NavMap workshop files: a tab between a key and its value.
 WITH_TABS = (
@@ -39,7 +40,7 @@ def test_a_malformed_file_still_names_the_line(tmp_path):
 @pytest.mark.ros
 def test_easynav_check_loads_a_params_file_with_tabs(tmp_path):
     # The Dummy system's file with tabs in place of the spaces after some keys.
-    text = (REPO / "params" / "dummy.params.yaml").read_text()
+    text = yaml.safe_dump(system_params(), sort_keys=False)
     text = text.replace("rt_freq: ", "rt_freq:\t").replace("freq: ", "freq:\t")
     assert "\t" in text
     path = tmp_path / "tabs.params.yaml"
