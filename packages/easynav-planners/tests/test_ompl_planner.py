@@ -242,6 +242,8 @@ def test_the_shipped_params_files_configure_the_plugin(name, space):
     from easynav.core.plugins.plugin_kinds import PLANNER
 
     path = FilePath(__file__).resolve().parents[3] / "params" / name
+    if not path.exists():
+        pytest.skip("the repository's params/ is not here (the package is installed alone)")
     section = yaml.safe_load(path.read_text())["planner_node"]["ros__parameters"]
     (alias,) = section["planner_types"]
     settings = {k: v for k, v in section[alias].items() if k != "plugin"}
