@@ -185,7 +185,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=400, help="scans per measurement")
     parser.add_argument("--rate", type=float, default=20.0, help="scans per second")
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
     os.environ["ROS_DOMAIN_ID"] = str(reserve_domain(f"bench/{os.getpid()}"))
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"

@@ -131,7 +131,7 @@ def main() -> int:
     parser.add_argument("--reference-world", default="home",
                         help="world of the reference stack (the simple stack's own)")
     parser.add_argument("--lap", type=float, default=120.0, help="estimated seconds per lap")
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
     timeout = args.minutes * 60.0 * 3 + 120.0
     ours = measure(Path(args.params), args.world, patrol(args.world, args.minutes, args.lap),

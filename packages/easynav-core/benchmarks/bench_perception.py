@@ -187,7 +187,7 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=200, help="timed runs per figure")
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
     repeat = args.repeat
     buffer = robot_tf()

@@ -110,7 +110,7 @@ def one_twist(now, cmd, takeover, override, paused, safety, inhibited) -> Twist:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--cycles", type=int, default=50_000)
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
 
     idle = scenario("idle", args.cycles)

@@ -68,7 +68,7 @@ def median_ms(fn, repeats: int) -> tuple[float, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=50)
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
     rows = []
     world = SimpleMap.load(resolve_map_file("easynav_maps", "worlds/home.map"))

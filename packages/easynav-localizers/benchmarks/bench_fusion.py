@@ -71,7 +71,7 @@ def run_reference(cycles: int) -> np.ndarray:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cycles", type=int, default=2000)
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
     ours = run_ours(args.cycles)
     ref = run_reference(args.cycles)

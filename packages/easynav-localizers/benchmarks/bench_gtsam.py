@@ -48,7 +48,7 @@ def drive(estimator: FactorGraphEstimator, seconds: float, seed: int = 0) -> np.
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=60.0)
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
     window = min(10.0, args.minutes / 2) * 60.0 * RATE / GNSS_EVERY
     # keyframe_period above the GNSS period: every keyframe is a GNSS one (one update each).

@@ -69,7 +69,7 @@ def median_us(fn, repeat: int = 2000) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    add_json_option(parser)
+    add_json_option(parser)  # --json PATH: the rows as JSON (benchmark convention)
     args = parser.parse_args()
     context = PluginContext(
         parameters=DictParameters({}),

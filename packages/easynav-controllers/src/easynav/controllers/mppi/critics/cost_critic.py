@@ -69,4 +69,5 @@ class CostCritic(Critic):
         batch.costs += term if power == 1 else term**power
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:  # pragma: no cover - score()
-        raise NotImplementedError("CostCritic scores in score()")
+        """Not used: this critic adds its two terms (collision, graded cost) in :meth:`score`."""
+        return None
