@@ -26,6 +26,7 @@ from rclpy.executors import SingleThreadedExecutor
 from easynav.core.goals.goal_client_state import GoalClientState as S
 from easynav.core.goals.goal_manager_client import GoalManagerClient
 from easynav.core.goals.navigation_control import NavigationControl
+from easynav.core.goals.safe_interrupt import SafeInterrupt
 from easynav.core.types import Header, Pose, PoseStamped
 
 EXIT_FINISHED = 0
@@ -129,7 +130,8 @@ def goal_command(
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
         client = GoalManagerClient(node)
-        return _run(args, node, executor, client, out, err)
+        with SafeInterrupt() as interrupt:
+            return _run(args, node, executor, client, interrupt, out, err)
     finally:
         if client is not None:
             client.destroy()
@@ -182,10 +184,11 @@ def latlon_to_map(
     return UtmProjection(float(origin[0]), float(origin[1])).forward(latitude, longitude)
 
 
-def _run(args, node, executor, client: GoalManagerClient, out: TextIO, err: TextIO) -> int:
+def _run(args, node, executor, client: GoalManagerClient, interrupt: SafeInterrupt,
+         out: TextIO, err: TextIO) -> int:
     namespace = node.get_namespace()
     try:
-        if not _spin_until(executor, client.manager_available, args.connect_timeout):
+        if not _spin_until(executor, client.manager_available, args.connect_timeout, interrupt):
             print(
                 f"easynav goal: no EasyNav goal manager found in namespace '{namespace}' within "
                 f"{args.connect_timeout:g} s (is `easynav run` up, with the same namespace and "
@@ -200,18 +203,20 @@ def _run(args, node, executor, client: GoalManagerClient, out: TextIO, err: Text
         )
         _say(out, f"Goal ({args.x:g}, {args.y:g}, yaw {args.yaw:g}) in '{args.frame}' sent to "
                   f"the goal manager in '{namespace}'")
-        return _follow(args, executor, client, out, err)
+        return _follow(args, executor, client, interrupt, out, err)
     except KeyboardInterrupt:
         _say(out, "Interrupted: cancelling the goal")
-        _cancel_and_wait(executor, client, out)
+        _cancel_and_wait(executor, client, interrupt, out)
         return EXIT_INTERRUPTED
 
 
-def _follow(args, executor, client: GoalManagerClient, out: TextIO, err: TextIO) -> int:
+def _follow(args, executor, client: GoalManagerClient, interrupt: SafeInterrupt,
+            out: TextIO, err: TextIO) -> int:
     deadline = None if args.timeout is None else time.monotonic() + args.timeout
     state = client.get_state()
     next_progress = time.monotonic() + PROGRESS_PERIOD
     while not state.is_terminal:
+        interrupt.check()
         executor.spin_once(timeout_sec=SPIN_STEP)
         now = time.monotonic()
         new_state = client.get_state()
@@ -225,7 +230,7 @@ def _follow(args, executor, client: GoalManagerClient, out: TextIO, err: TextIO)
                 _say(out, _progress_line(feedback, state))
         if deadline is not None and now >= deadline and not state.is_terminal:
             _say(out, f"Timeout after {args.timeout:g} s: cancelling the goal")
-            _cancel_and_wait(executor, client, out)
+            _cancel_and_wait(executor, client, interrupt, out)
             return EXIT_TIMEOUT
     result = client.get_result()
     if state is S.NAVIGATION_FINISHED:
@@ -248,12 +253,15 @@ def _progress_line(feedback: NavigationControl, state: S) -> str:
     )
 
 
-def _cancel_and_wait(executor, client: GoalManagerClient, out: TextIO) -> None:
+def _cancel_and_wait(executor, client: GoalManagerClient, interrupt: SafeInterrupt,
+                     out: TextIO) -> None:
+    """Cancel the goal and wait for the answer; one more Ctrl-C stops waiting."""
     if not client.get_state().is_navigating:
         return
     client.cancel()
     try:
-        confirmed = _spin_until(executor, lambda: client.get_state().is_terminal, CANCEL_WAIT)
+        confirmed = _spin_until(executor, lambda: client.get_state().is_terminal, CANCEL_WAIT,
+                                interrupt, interrupt.presses)
     except KeyboardInterrupt:
         confirmed = False
     if confirmed:
@@ -262,13 +270,15 @@ def _cancel_and_wait(executor, client: GoalManagerClient, out: TextIO) -> None:
         _say(out, "The goal manager did not confirm the cancellation")
 
 
-def _spin_until(executor: Any, done, timeout: float) -> bool:
+def _spin_until(executor: Any, done, timeout: float, interrupt: SafeInterrupt,
+                presses_seen: int = 0) -> bool:
     deadline = time.monotonic() + timeout
     while True:
         if done():
             return True
         if time.monotonic() >= deadline:
             return False
+        interrupt.check(presses_seen)
         executor.spin_once(timeout_sec=SPIN_STEP)
 
 
