@@ -2,31 +2,17 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
-from easynav.core.nav_state_keys import GOALS, PATH, ROBOT_POSE
-from easynav.core.plugins import Param, PlannerMethodBase, Topic
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
-from easynav.core.types import (
-    Costmap2D,
-    DiagnosticLevel,
-    DiagnosticStatus,
-    Goals,
-    Header,
-    Odometry,
-    Path,
-)
+from easynav.core.nav_state_keys import GOALS, ROBOT_POSE
+from easynav.core.plugins import Param
+from easynav.core.types import Costmap2D, Header, Odometry, Path
 from easynav.maps.costmap.keys import MAP, MAP_BASE, MAP_TIME
 from easynav.planners.costmap_astar import BLOCKED_COST, astar_costmap, compiled_available
+from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, PathPlannerBase
 
-#: The planner's diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
-DIAGNOSTIC_NAME = "path"
-HARDWARE_ID = "planner"
+__all__ = ["DIAGNOSTIC_NAME", "HARDWARE_ID", "CostmapPlanner", "smooth_path"]
 #: Width of the moving average that smooths the cell path (the original's 5 points).
 SMOOTHING_WINDOW = 5
 
@@ -45,7 +31,7 @@ def smooth_path(points: np.ndarray, window: int = SMOOTHING_WINDOW) -> np.ndarra
     return (cumulative[i + reach + 1] - cumulative[i - reach]) / (2 * reach + 1)[:, None]
 
 
-class CostmapPlanner(PlannerMethodBase):
+class CostmapPlanner(PathPlannerBase):
     """Plans to the first goal with 8-connected A* over NavState ``map`` (a :class:`Costmap2D`).
 
     Cost of entering a cell of cost ``c``: ``(1 + cost_factor * c)`` per cell of length
@@ -95,119 +81,80 @@ class CostmapPlanner(PlannerMethodBase):
         ),
         Param("continuous_replan", True, "plan every cycle (false: only on a new goal or block)"),
     )
-    TOPICS = (Topic("path", "nav_msgs/msg/Path", "pub"),)
     READS = (GOALS, ROBOT_POSE, MAP, MAP_BASE, MAP_TIME)
-    WRITES = (PATH,)
     NEEDS_MAPS = ("costmap",)
 
     def __init__(self) -> None:
         super().__init__()
-        self._throttle = WarningThrottle(period=5.0)
-        self._last_status: tuple[int, str] | None = None
-        self._publisher = None
         self._last_goal: tuple[float, float, float] | None = None
         self._last_cells: np.ndarray | None = None
         self._last_path: Path | None = None
 
-    def on_initialize(self) -> None:
-        self._destroy_publisher()
-        self._last_status = None
-        self._last_goal = self._last_cells = self._last_path = None
+    def configure_planner(self) -> None:
+        """Warn when A* cannot be compiled."""
         if not compiled_available():
             self.logger.warning(
                 f"{self.plugin_name}: numba is not installed, A* runs in pure Python (tens of "
                 "times slower on large maps): pip install easynav-planners[numba]"
             )
-        node = self.context.node
-        if node is not None:
-            from nav_msgs.msg import Path as PathMsg
 
-            topic = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}/path"
-            self._publisher = node.create_publisher(PathMsg, topic, 10)
-
-    def on_cleanup(self) -> None:
-        self._destroy_publisher()
-
-    def _destroy_publisher(self) -> None:
-        if self._publisher is not None and self.context.node is not None:
-            self.context.node.destroy_publisher(self._publisher)
-        self._publisher = None
+    def forget_path(self) -> None:
+        """The kept path (``continuous_replan`` false) is no longer the answer."""
+        self._last_goal = self._last_cells = self._last_path = None
 
     # -- update -------------------------------------------------------------------------------
-    def update(self, nav_state: NavState) -> None:
-        """Plan to the first goal and write ``path``. Non-RT thread."""
-        if not nav_state.has(GOALS):
-            return
-        map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
-        goals = nav_state.get(GOALS, Goals)
-        if len(goals) == 0:
-            self._last_goal = None
-            self._write(nav_state, Path(Header(self.now(), map_frame)), None, "idle: no goal")
-            return
-        goal = goals.goals[0]
-        gx, gy, gyaw = goal.pose.x, goal.pose.y, goal.pose.yaw
-        goal_text = f"goal ({gx:.2f}, {gy:.2f})"
-        if not all(math.isfinite(v) for v in (gx, gy, gyaw)):
-            self._reject(nav_state, map_frame, f"{goal_text} is not finite")
-            return
-        frame = goal.header.frame_id or goals.header.frame_id
-        if frame and frame != map_frame:
-            self._reject(nav_state, map_frame, f"{goal_text} is in frame '{frame}', not "
-                         f"'{map_frame}'")
-            return
-        if nav_state.has(MAP_BASE):
-            problem = self._static_goal_problem(nav_state.get(MAP_BASE, Costmap2D), gx, gy)
-            if problem is not None:
-                self._reject(nav_state, map_frame, f"{goal_text} {problem}")
-                return
-        if not nav_state.has(ROBOT_POSE):
-            self._fail(nav_state, map_frame, f"{goal_text}: no robot_pose yet")
-            return
-        robot = nav_state.get(ROBOT_POSE, Odometry)
-        if not robot.is_finite():
-            self._fail(nav_state, map_frame, f"{goal_text}: robot_pose is not finite")
-            return
+    def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,
+                            goal_text: str) -> str | None:
+        """Off ``map.base``, or on a wall or unknown cell of it."""
+        if not nav_state.has(MAP_BASE):
+            return None
+        problem = self._static_goal_problem(nav_state.get(MAP_BASE, Costmap2D), gx, gy)
+        return None if problem is None else f"{goal_text} {problem}"
+
+    def plan_to(self, nav_state: NavState, robot: Odometry, goal: tuple[float, float, float],
+                goal_text: str, map_frame: str) -> None:
+        """A* over NavState ``map``, or the kept path (``continuous_replan`` false)."""
         if not nav_state.has(MAP):
-            self._fail(nav_state, map_frame, f"{goal_text}: no costmap yet (NavState '{MAP}')")
+            self.fail(nav_state, map_frame, f"{goal_text}: no costmap yet (NavState '{MAP}')")
             return
         costmap = nav_state.get(MAP, Costmap2D)
-        if not self.params.continuous_replan and self._can_keep(costmap, (gx, gy, gyaw)):
-            self._write(nav_state, self._last_path, None, self._ok_message(goal_text))
+        if not self.params.continuous_replan and self._can_keep(costmap, goal):
+            self.write_path(nav_state, self._last_path, self._ok_message(goal_text))
             return
-        self._plan(nav_state, costmap, robot, (gx, gy, gyaw), goal_text, map_frame)
+        self._plan(nav_state, costmap, robot, goal, goal_text, map_frame)
 
     def _plan(self, nav_state, costmap, robot, goal, goal_text, map_frame) -> None:
         gx, gy, gyaw = goal
         six, siy = (int(v) for v in costmap.world_to_cell(robot.pose.x, robot.pose.y))
         gix, giy = (int(v) for v in costmap.world_to_cell(gx, gy))
         if not costmap.in_bounds(gix, giy):
-            self._reject(nav_state, map_frame, f"{goal_text} is off the costmap "
-                         f"{self._extent_text(costmap)}")
+            self.reject(nav_state, map_frame, f"{goal_text} is off the costmap "
+                        f"{self._extent_text(costmap)}")
             return
         if not costmap.in_bounds(six, siy):
-            self._fail(nav_state, map_frame, f"{goal_text}: the robot ({robot.pose.x:.2f}, "
-                       f"{robot.pose.y:.2f}) is off the costmap {self._extent_text(costmap)}")
+            self.fail(nav_state, map_frame, f"{goal_text}: the robot ({robot.pose.x:.2f}, "
+                      f"{robot.pose.y:.2f}) is off the costmap {self._extent_text(costmap)}")
             return
         goal_cost = int(costmap.data[giy, gix])
         if goal_cost >= BLOCKED_COST:
             what = {253: "inside the inflated zone of an obstacle (cost 253)",
                     254: "on an obstacle (cost 254)", 255: "on unknown space (cost 255)"}
-            self._fail(nav_state, map_frame, f"{goal_text} is {what[goal_cost]} in the costmap")
+            self.fail(nav_state, map_frame, f"{goal_text} is {what[goal_cost]} in the costmap")
             return
         cells, _ = astar_costmap(
             costmap.data, (six, siy), (gix, giy),
             self.params.cost_factor, self.params.heuristic_scale,
         )
         if cells is None:
-            self._fail(nav_state, map_frame, f"no route from ({robot.pose.x:.2f}, "
-                       f"{robot.pose.y:.2f}) to {goal_text}: blocked in the costmap")
+            self.fail(nav_state, map_frame, f"no route from ({robot.pose.x:.2f}, "
+                      f"{robot.pose.y:.2f}) to {goal_text}: blocked in the costmap")
             return
         stamp = (
             float(nav_state.get(MAP_TIME)) if nav_state.has(MAP_TIME) else float(costmap.stamp)
         )
         path = Path.from_xy_yaw(self._poses(costmap, cells, goal), Header(stamp, map_frame))
         self._last_goal, self._last_cells, self._last_path = goal, cells, path
-        self._write(nav_state, path, None, self._ok_message(goal_text, path))
+        self.write_path(nav_state, path, self._ok_message(goal_text, path))
 
     @staticmethod
     def _poses(costmap: Costmap2D, cells: np.ndarray, goal) -> np.ndarray:
@@ -261,35 +208,3 @@ class CostmapPlanner(PlannerMethodBase):
         xy = np.array([[p.x, p.y] for p in path.poses])
         length = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
         return f"path of {length:.2f} m to {goal_text}"
-
-    def _reject(self, nav_state: NavState, map_frame: str, reason: str) -> None:
-        self.reject_goal(reason)
-        self._fail(nav_state, map_frame, reason)
-
-    def _fail(self, nav_state: NavState, map_frame: str, reason: str) -> None:
-        self._last_goal = self._last_cells = self._last_path = None
-        self._throttle.warn(self.logger, reason, f"{self.plugin_name}: no path: {reason}")
-        self._write(nav_state, Path(Header(self.now(), map_frame)), reason, reason)
-
-    def _write(self, nav_state: NavState, path: Path, failure: str | None, message: str) -> None:
-        nav_state.set(PATH, path)
-        level = DiagnosticLevel.WARN if failure else DiagnosticLevel.OK
-        # Written on changes only; the path length alone changing is not news.
-        summary = (int(level), failure or message.split(" to ")[-1])
-        if summary != self._last_status:
-            self._last_status = summary
-            write_diagnostic(
-                nav_state,
-                DIAGNOSTIC_NAME,
-                DiagnosticStatus(
-                    level=level,
-                    message=message,
-                    hardware_id=HARDWARE_ID,
-                    values={"poses": str(len(path)), "plugin": self.plugin_name},
-                ),
-            )
-        publisher = self._publisher
-        if publisher is not None and publisher.get_subscription_count() > 0:
-            from easynav.core.ros.converters import path_to_msg
-
-            publisher.publish(path_to_msg(path))

@@ -6,34 +6,15 @@ from typing import Any
 
 import numpy as np
 
-from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import GOALS, PATH, ROBOT_POSE
-from easynav.core.plugins import (
-    Param,
-    ParameterValueError,
-    PlannerMethodBase,
-    PluginConfigurationError,
-    Topic,
-)
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
-from easynav.core.types import (
-    LETHAL_OBSTACLE,
-    Costmap2D,
-    DiagnosticLevel,
-    DiagnosticStatus,
-    Goals,
-    Header,
-    Odometry,
-    Path,
-)
+from easynav.core.plugins import Param, ParameterValueError, PluginConfigurationError
+from easynav.core.types import LETHAL_OBSTACLE, Costmap2D, Header, Odometry, Path
 from easynav.planners.ompl_grid_planner import PLANNERS, STATE_SPACES, OMPLGridPlanner
-from easynav.planners.planner_keys import DIAGNOSTICS_PATH, MAP, STATIC_MAP
+from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, PathPlannerBase
+from easynav.planners.planner_keys import MAP, STATIC_MAP
 
-#: The planner's diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
-DIAGNOSTIC_NAME = "path"
-HARDWARE_ID = "planner"
+__all__ = ["DIAGNOSTIC_NAME", "HARDWARE_ID", "OMPLPlanner", "as_costmap"]
 #: Parameters that shape the OMPL planner (a change rebuilds it and drops the current path).
 _PLANNER_PARAMETERS = (
     "state_space",
@@ -65,7 +46,7 @@ def as_costmap(world: Any) -> Costmap2D:
     raise TypeError(f"NavState '{MAP}' holds a {type(world).__name__}, not a Costmap2D")
 
 
-class OMPLPlanner(PlannerMethodBase):
+class OMPLPlanner(PathPlannerBase):
     """Plans to the first goal with OMPL (:class:`OMPLGridPlanner`) on NavState ``map``.
 
     The robot is a disc of ``system_node.robot_geometry.radius`` + ``clearance_distance``; the
@@ -109,16 +90,11 @@ class OMPLPlanner(PlannerMethodBase):
         Param("replan_deviation", 0.5, "replan when the robot is farther than this from the path",
               "m", gt=0.0),
     )
-    TOPICS = (Topic("path", "nav_msgs/msg/Path", "pub", description="every new plan"),)
     READS = (GOALS, ROBOT_POSE, MAP, STATIC_MAP)
-    WRITES = (PATH, DIAGNOSTICS_PATH)
 
     def __init__(self) -> None:
         super().__init__()
         self.planner: OMPLGridPlanner | None = None
-        self._throttle = WarningThrottle(period=5.0)
-        self._last_status: tuple[int, str] | None = None
-        self._publisher = None
         self._path: Path | None = None
         self._path_xy_yaw: np.ndarray | None = None
         self._path_goal: tuple | None = None
@@ -147,20 +123,12 @@ class OMPLPlanner(PlannerMethodBase):
             range=values["range"],
         )
 
-    def on_initialize(self) -> None:
-        self._destroy_publisher()
+    def configure_planner(self) -> None:
+        """The OMPL planner from the parameters (the ``ompl`` extra must be installed)."""
         try:
             self.planner = self._build()
         except (ValueError, ImportError) as exc:
             raise PluginConfigurationError(f"{self.plugin_name}: {exc}") from None
-        self._forget_path()
-        self._last_status = None
-        node = self.context.node
-        if node is not None:
-            from nav_msgs.msg import Path as PathMsg
-
-            topic = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}/path"
-            self._publisher = node.create_publisher(PathMsg, topic, 10)
 
     def validate_parameter(self, name: str, value: Any) -> Any:
         """As the base, and a combination OMPL cannot plan with (FMT in Dubins) is refused."""
@@ -176,18 +144,10 @@ class OMPLPlanner(PlannerMethodBase):
         """Rebuild the OMPL planner; the next update plans afresh."""
         if name in _PLANNER_PARAMETERS:
             self.planner = self._build()
-            self._forget_path()
+            self.forget_path()
 
-    def on_cleanup(self) -> None:
-        self._destroy_publisher()
-        self._forget_path()
-
-    def _destroy_publisher(self) -> None:
-        if self._publisher is not None and self.context.node is not None:
-            self.context.node.destroy_publisher(self._publisher)
-        self._publisher = None
-
-    def _forget_path(self) -> None:
+    def forget_path(self) -> None:
+        """The next update plans afresh."""
         self._path = None
         self._path_xy_yaw = None
         self._path_goal = None
@@ -199,72 +159,53 @@ class OMPLPlanner(PlannerMethodBase):
             self._map_source = world
         return self._map_costmap
 
-    def update(self, nav_state: NavState) -> None:
-        """Check the current path; plan again when needed; write ``path``. Non-RT thread."""
-        if not nav_state.has(GOALS) or self.planner is None:
-            return
+    def ready(self) -> bool:
+        """Configured: an OMPL planner exists."""
+        return self.planner is not None
+
+    def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,
+                            goal_text: str) -> str | None:
+        """Off ``map.base``, inside or too close to a wall of it."""
+        if not nav_state.has(STATIC_MAP):
+            return None
+        try:
+            static = as_costmap(nav_state.get(STATIC_MAP))
+        except TypeError:
+            return None  # not a map this planner reads: the map of the moment decides
+        return self.planner.pose_problem(static, gx, gy, "goal")
+
+    def plan_to(self, nav_state: NavState, robot: Odometry, goal: tuple[float, float, float],
+                goal_text: str, map_frame: str) -> None:
+        """Keep the current path while it is good, else plan with OMPL on NavState ``map``."""
         planner = self.planner
-        map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
-        goals = nav_state.get(GOALS, Goals)
-        if len(goals) == 0:
-            self._forget_path()
-            self._write(nav_state, Path(Header(self.now(), map_frame)), None, "idle: no goal")
-            return
-        goal = goals.goals[0]
-        gx, gy, gyaw = goal.pose.x, goal.pose.y, goal.pose.yaw
-        goal_text = f"goal ({gx:.2f}, {gy:.2f})"
-        frame = goal.header.frame_id or goals.header.frame_id
-        if frame and frame != map_frame:
-            self._forget_path()
-            reason = f"{goal_text} is in frame '{frame}', not '{map_frame}'"
-            self.reject_goal(reason)
-            self._fail(nav_state, map_frame, reason)
+        if not nav_state.has(MAP):
+            self.fail(nav_state, map_frame, f"{goal_text}: no map yet (NavState '{MAP}')")
             return
         try:
-            if nav_state.has(STATIC_MAP):
-                static = as_costmap(nav_state.get(STATIC_MAP))
-                problem = planner.pose_problem(static, gx, gy, "goal")
-                if problem is not None:
-                    self._forget_path()
-                    self.reject_goal(problem)
-                    self._fail(nav_state, map_frame, problem)
-                    return
-            if not nav_state.has(ROBOT_POSE):
-                self._fail(nav_state, map_frame, f"{goal_text}: no robot_pose yet")
-                return
-            robot = nav_state.get(ROBOT_POSE, Odometry)
-            if not robot.is_finite():
-                self._fail(nav_state, map_frame, f"{goal_text}: robot_pose is not finite")
-                return
-            if not nav_state.has(MAP):
-                self._fail(nav_state, map_frame, f"{goal_text}: no map yet (NavState '{MAP}')")
-                return
             costmap = self._costmap(nav_state.get(MAP))
         except TypeError as exc:
-            self._fail(nav_state, map_frame, f"{goal_text}: {exc}")
+            self.fail(nav_state, map_frame, f"{goal_text}: {exc}")
             return
-        goal_key = (gx, gy, gyaw, frame)
         robot_xy = (robot.pose.x, robot.pose.y)
-        if self._path is not None and self._path_goal == goal_key:
+        if self._path is not None and self._path_goal == goal:
             if self._path_still_good(costmap, robot_xy):
                 nav_state.set(PATH, self._path)
                 return
-        self._forget_path()
-        result = planner.plan(costmap, (robot.pose.x, robot.pose.y, robot.pose.yaw),
-                              (gx, gy, gyaw))
+        self.forget_path()
+        result = planner.plan(costmap, (robot.pose.x, robot.pose.y, robot.pose.yaw), goal)
         self.plan_count += 1
         if not result.ok:
-            self._fail(nav_state, map_frame, result.reason)
+            self.fail(nav_state, map_frame, result.reason)
             return
         path = Path.from_xy_yaw(result.poses, Header(self.now(), map_frame))
-        self._path, self._path_xy_yaw, self._path_goal = path, result.poses, goal_key
+        self._path, self._path_xy_yaw, self._path_goal = path, result.poses, goal
         stats = planner.last_stats
         self.logger.debug(
             f"{self.plugin_name}: {planner.planner} in {planner.state_space}: path of "
             f"{result.length:.2f} m to {goal_text} in {stats.solve_time:.3f} s "
             f"({stats.validity_checks} validity checks)"
         )
-        self._write(nav_state, path, None, f"path of {result.length:.2f} m to {goal_text}")
+        self.write_path(nav_state, path, f"path of {result.length:.2f} m to {goal_text}")
 
     def _path_still_good(self, costmap: Costmap2D, robot_xy: tuple[float, float]) -> bool:
         """Whether the robot is near the current path and the path ahead of it is clear."""
@@ -285,30 +226,3 @@ class OMPLPlanner(PlannerMethodBase):
             body.polyline_free(xy[ahead : ahead + escape + 1])[0]
             and footprint.polyline_free(xy[ahead + escape :])[0]
         )
-
-    def _fail(self, nav_state: NavState, map_frame: str, reason: str) -> None:
-        self._throttle.warn(self.logger, reason, f"{self.plugin_name}: no path: {reason}")
-        self._write(nav_state, Path(Header(self.now(), map_frame)), reason, reason)
-
-    def _write(self, nav_state: NavState, path: Path, failure: str | None, message: str) -> None:
-        nav_state.set(PATH, path)
-        level = DiagnosticLevel.WARN if failure else DiagnosticLevel.OK
-        # Written on changes only; a new plan to the same goal is not news.
-        summary = (int(level), failure or message.split(" m to ")[-1])
-        if summary != self._last_status:
-            self._last_status = summary
-            write_diagnostic(
-                nav_state,
-                DIAGNOSTIC_NAME,
-                DiagnosticStatus(
-                    level=level,
-                    message=message,
-                    hardware_id=HARDWARE_ID,
-                    values={"poses": str(len(path)), "plugin": self.plugin_name},
-                ),
-            )
-        publisher = self._publisher
-        if publisher is not None and publisher.get_subscription_count() > 0:
-            from easynav.core.ros.converters import path_to_msg
-
-            publisher.publish(path_to_msg(path))

@@ -4,26 +4,22 @@ from __future__ import annotations
 
 import math
 
-from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
-from easynav.core.nav_state_keys import DIAGNOSTICS_PATH, GOALS, MAP, MAP_BASE, PATH, ROBOT_POSE
-from easynav.core.plugins import Param, PlannerMethodBase, PluginConfigurationError, Topic
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
-from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Goals, Header, Odometry, Path
+from easynav.core.nav_state_keys import GOALS, MAP, MAP_BASE, PATH, ROBOT_POSE
+from easynav.core.plugins import Param, PluginConfigurationError
+from easynav.core.types import Header, Odometry, Path
 from easynav.maps import SimpleMap
+from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, PathPlannerBase
 from easynav.planners.simple_grid_planner import SimpleGridPlanner
 
 #: NavState keys.
 MAP_KEY = MAP
 STATIC_MAP_KEY = MAP_BASE
 PATH_KEY = PATH
-#: The planner's diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
-DIAGNOSTIC_NAME = "path"
-HARDWARE_ID = "planner"
+__all__ = ["DIAGNOSTIC_NAME", "HARDWARE_ID", "SimplePlanner"]
 
 
-class SimplePlanner(PlannerMethodBase):
+class SimplePlanner(PathPlannerBase):
     """Plans to the first goal with :class:`SimpleGridPlanner` on NavState ``map``.
 
     Parameters: :attr:`PARAMETERS`. ``robot_radius`` is deprecated: the robot's radius is
@@ -57,37 +53,15 @@ class SimplePlanner(PlannerMethodBase):
         Param("smooth_path", True,
               "shorten the A* path by line of sight (false: the raw 8-connected cell path)"),
     )
-    TOPICS = (Topic("<node>/<alias>/path", "nav_msgs/msg/Path", "pub",
-                    description="the path, while subscribed"),)
     READS = (GOALS, ROBOT_POSE, MAP, MAP_BASE)
-    WRITES = (PATH, DIAGNOSTICS_PATH)
 
     def __init__(self) -> None:
         super().__init__()
         self.planner = SimpleGridPlanner()
-        self._throttle = WarningThrottle(period=5.0)
-        self._last_status: tuple[int, str] | None = None
-        self._publisher = None
 
-    def on_initialize(self) -> None:
-        self._destroy_publisher()
-        alias = self.plugin_name
+    def configure_planner(self) -> None:
+        """A grid planner with the robot's radius and the parameters."""
         self.planner = self._make_planner()
-        self._last_status = None
-        node = self.context.node
-        if node is not None:
-            from nav_msgs.msg import Path as PathMsg
-
-            topic = f"{node.get_fully_qualified_name().rstrip('/')}/{alias}/path"
-            self._publisher = node.create_publisher(PathMsg, topic, 10)
-
-    def on_cleanup(self) -> None:
-        self._destroy_publisher()
-
-    def _destroy_publisher(self) -> None:
-        if self._publisher is not None and self.context.node is not None:
-            self.context.node.destroy_publisher(self._publisher)
-        self._publisher = None
 
     def _make_planner(self) -> SimpleGridPlanner:
         try:
@@ -120,74 +94,25 @@ class SimplePlanner(PlannerMethodBase):
         return legacy
 
     # -- update -------------------------------------------------------------------------------
-    def update(self, nav_state: NavState) -> None:
-        """Plan to the first goal and write ``path``. Non-RT thread."""
-        if not nav_state.has(GOALS):
-            return
-        map_frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
-        goals = nav_state.get(GOALS, Goals)
-        if len(goals) == 0:
-            self._write(nav_state, Path(Header(self.now(), map_frame)), None, "idle: no goal")
-            return
-        goal = goals.goals[0]
-        gx, gy, gyaw = goal.pose.x, goal.pose.y, goal.pose.yaw
-        goal_text = f"goal ({gx:.2f}, {gy:.2f})"
-        frame = goal.header.frame_id or goals.header.frame_id
-        if frame and frame != map_frame:
-            reason = f"{goal_text} is in frame '{frame}', not '{map_frame}'"
-            self.reject_goal(reason)
-            self._fail(nav_state, map_frame, reason)
-            return
-        if nav_state.has(STATIC_MAP_KEY):
-            # Off the static map or inside (the clearance of) a wall: no path will ever come.
-            problem = self.planner.goal_problem(nav_state.get(STATIC_MAP_KEY, SimpleMap), (gx, gy))
-            if problem is not None:
-                self.reject_goal(problem)
-                self._fail(nav_state, map_frame, problem)
-                return
-        if not nav_state.has(ROBOT_POSE):
-            self._fail(nav_state, map_frame, f"{goal_text}: no robot_pose yet")
-            return
-        robot = nav_state.get(ROBOT_POSE, Odometry)
-        if not robot.is_finite():
-            self._fail(nav_state, map_frame, f"{goal_text}: robot_pose is not finite")
-            return
+    def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,
+                            goal_text: str) -> str | None:
+        """Off the static map or inside (the clearance of) a wall: no path will ever come."""
+        if not nav_state.has(STATIC_MAP_KEY):
+            return None
+        return self.planner.goal_problem(nav_state.get(STATIC_MAP_KEY, SimpleMap), (gx, gy))
+
+    def plan_to(self, nav_state: NavState, robot: Odometry, goal: tuple[float, float, float],
+                goal_text: str, map_frame: str) -> None:
+        """A* on NavState ``map`` (the static map with the live obstacles)."""
         if not nav_state.has(MAP_KEY):
-            self._fail(nav_state, map_frame, f"{goal_text}: no map yet (NavState '{MAP_KEY}')")
+            self.fail(nav_state, map_frame, f"{goal_text}: no map yet (NavState '{MAP_KEY}')")
             return
         world = nav_state.get(MAP_KEY, SimpleMap)
-        result = self.planner.plan(world, (robot.pose.x, robot.pose.y), (gx, gy, gyaw))
+        result = self.planner.plan(world, (robot.pose.x, robot.pose.y), goal)
         if not result.ok:
-            self._fail(nav_state, map_frame, result.reason)
+            self.fail(nav_state, map_frame, result.reason)
             return
         # Stamped with the planning time on the node clock (the original took the newer of the
         # pose and goal stamps, which is a wall-clock time when a goal client ignores sim time).
         path = Path.from_xy_yaw(result.poses, Header(self.now(), map_frame))
-        self._write(nav_state, path, None, f"path of {result.length:.2f} m to {goal_text}")
-
-    def _fail(self, nav_state: NavState, map_frame: str, reason: str) -> None:
-        self._throttle.warn(self.logger, reason, f"{self.plugin_name}: no path: {reason}")
-        self._write(nav_state, Path(Header(self.now(), map_frame)), reason, reason)
-
-    def _write(self, nav_state: NavState, path: Path, failure: str | None, message: str) -> None:
-        nav_state.set(PATH_KEY, path)
-        level = DiagnosticLevel.WARN if failure else DiagnosticLevel.OK
-        # Written on changes only; the path length alone changing is not news.
-        summary = (int(level), failure or message.split(" m to ")[-1])
-        if summary != self._last_status:
-            self._last_status = summary
-            write_diagnostic(
-                nav_state,
-                DIAGNOSTIC_NAME,
-                DiagnosticStatus(
-                    level=level,
-                    message=message,
-                    hardware_id=HARDWARE_ID,
-                    values={"poses": str(len(path)), "plugin": self.plugin_name},
-                ),
-            )
-        publisher = self._publisher
-        if publisher is not None and publisher.get_subscription_count() > 0:
-            from easynav.core.ros.converters import path_to_msg
-
-            publisher.publish(path_to_msg(path))
+        self.write_path(nav_state, path, f"path of {result.length:.2f} m to {goal_text}")
