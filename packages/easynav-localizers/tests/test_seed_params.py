@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import pytest
-import yaml
 
-from easynav.core.plugins import PluginContext
-from easynav.core.plugins.discovery import load_plugin_class
 from easynav.core.plugins.plugin_kinds import LOCALIZER
+from easynav.core.testing.params_section_plugin import plugin_from_params_section
 
 pytestmark = pytest.mark.ros
 
@@ -36,33 +34,13 @@ localizer_node:
 
 
 def test_seed_section_configures_the_plugin_through_ros_parameters(tmp_path):
-    rclpy = pytest.importorskip("rclpy")
-    from easynav.core.system.node_parameters import NodeParameters
-
-    params_file = tmp_path / "simple.params.yaml"
-    params_file.write_text(SEED)
-    section = yaml.safe_load(SEED)["localizer_node"]["ros__parameters"]
-    assert section["localizer_types"] == ["simple"]
-    context = rclpy.Context()
-    rclpy.init(args=["--ros-args", "--params-file", str(params_file)], context=context)
-    try:
-        node = rclpy.create_node("localizer_node", context=context)
-        cls = load_plugin_class(
-            LOCALIZER, section["simple"]["plugin"], "localizer_node.simple.plugin"
-        )
-        plugin = cls()
-        plugin.initialize(
-            PluginContext(
-                parameters=NodeParameters(node), node=None, namespace="seed_localizer_node"
-            ),
-            "simple",
-        )
+    pytest.importorskip("rclpy")
+    seed = plugin_from_params_section(SEED, "localizer_node", LOCALIZER, tmp_path)
+    with seed as (plugin, section):
+        assert section["localizer_types"] == ["simple"]
         assert (plugin.rt_freq, plugin.freq) == (50.0, 5.0)
         assert plugin.reseed_period == 1.0
         assert len(plugin.filter) == 100
         assert plugin.noise == (0.05, 0.1, 0.1)
         assert plugin.filter.poses[:, :2].std(axis=0).max() < 0.2  # std_dev_xy 0.1
         assert plugin.min_noise_yaw == 0.05
-        node.destroy_node()
-    finally:
-        rclpy.shutdown(context=context)

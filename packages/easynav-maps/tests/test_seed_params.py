@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import pytest
-import yaml
 
-from easynav.core.plugins import PluginContext
-from easynav.core.plugins.discovery import load_plugin_class
 from easynav.core.plugins.plugin_kinds import MAPS_MANAGER
+from easynav.core.testing.params_section_plugin import plugin_from_params_section
 
 pytestmark = pytest.mark.ros
 
@@ -26,31 +24,11 @@ maps_manager_node:
 
 
 def test_seed_section_configures_the_plugin_through_ros_parameters(tmp_path):
-    rclpy = pytest.importorskip("rclpy")
-    from easynav.core.system.node_parameters import NodeParameters
-
-    params_file = tmp_path / "simple.params.yaml"
-    params_file.write_text(SEED)
-    section = yaml.safe_load(SEED)["maps_manager_node"]["ros__parameters"]
-    assert section["map_types"] == ["simple"]
-    context = rclpy.Context()
-    rclpy.init(args=["--ros-args", "--params-file", str(params_file)], context=context)
-    try:
-        node = rclpy.create_node("maps_manager_node", context=context)
-        cls = load_plugin_class(
-            MAPS_MANAGER, section["simple"]["plugin"], "maps_manager_node.simple.plugin"
-        )
-        plugin = cls()
-        plugin.initialize(
-            PluginContext(
-                parameters=NodeParameters(node), node=None, namespace="seed_maps_manager_node"
-            ),
-            "simple",
-        )
+    pytest.importorskip("rclpy")
+    seed = plugin_from_params_section(SEED, "maps_manager_node", MAPS_MANAGER, tmp_path)
+    with seed as (plugin, section):
+        assert section["map_types"] == ["simple"]
         # The seed names easynav_playground_kobuki's maps/home.map; the same parameters find
         # the house shipped here (easynav-playground ships its own worlds the same way).
         assert plugin.freq == 10.0
         assert plugin.static_map.width == 280
-        node.destroy_node()
-    finally:
-        rclpy.shutdown(context=context)
