@@ -1,5 +1,5 @@
 # The two commands of the README. Both set up .venv/ first (quick when it is up to date).
-.PHONY: demo test setup bench matrix dist isolated
+.PHONY: demo test setup bench matrix soak dist isolated
 
 demo: setup
 	.venv/bin/easynav demo
@@ -10,6 +10,10 @@ test: setup
 # Every benchmark script of every package, one table: docs/benchmarks.md (tens of minutes).
 bench: setup
 	.venv/bin/python tools/run_benchmarks.py
+
+# An hour of simulated patrol on the warehouse, faster than real time: docs/soak.md (~25 min).
+soak: setup
+	.venv/bin/python benchmarks/soak.py
 
 # Every compatible plugin combination in every world: docs/matrix.md (long: a mission per row).
 matrix: setup

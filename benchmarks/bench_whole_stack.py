@@ -18,82 +18,16 @@ from __future__ import annotations
 
 import argparse
 import io
-import os
-import statistics
 import sys
 import tempfile
-import threading
-import time
 from pathlib import Path
 
 import yaml
 
 from easynav.core.benchmarking import BenchRow, add_json_option, report
+from easynav.playground.instruments.process_sampler import ProcessSampler
 
 REPO = Path(__file__).resolve().parent.parent
-CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
-PAGE = os.sysconf("SC_PAGE_SIZE")
-
-
-def find_easynav(run_dir: Path) -> int | None:
-    """The pid of the `easynav run` process of this run (its command line names run_dir)."""
-    marker = str(run_dir)
-    for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
-        except OSError:
-            continue
-        if " run " in cmdline and marker in cmdline and "easynav" in cmdline:
-            return int(entry.name)
-    return None
-
-
-def cpu_seconds_and_rss(pid: int) -> tuple[float, float] | None:
-    """CPU seconds used so far (user + system, all threads) and resident memory in MB."""
-    try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        rss_pages = int(Path(f"/proc/{pid}/statm").read_text().split()[1])
-    except (OSError, IndexError, ValueError):
-        return None
-    utime, stime = int(fields[11]), int(fields[12])
-    return (utime + stime) / CLOCK_TICKS, rss_pages * PAGE / 1e6
-
-
-class Sampler(threading.Thread):
-    """Samples the EasyNav process of a run every second until stopped."""
-
-    def __init__(self, run_dir: Path) -> None:
-        super().__init__(daemon=True)
-        self.run_dir = run_dir
-        self.samples: list[tuple[float, float, float]] = []  # wall, cpu seconds, rss MB
-        self.stop_event = threading.Event()
-
-    def run(self) -> None:
-        pid = None
-        while not self.stop_event.wait(1.0):
-            pid = pid or find_easynav(self.run_dir)
-            if pid is None:
-                continue
-            sample = cpu_seconds_and_rss(pid)
-            if sample is None:
-                if self.samples:
-                    return  # the process ended
-                continue
-            self.samples.append((time.monotonic(), *sample))
-
-    def figures(self, skip: float = 20.0) -> tuple[float, float, float]:
-        """CPU % of one core, median and max RSS (MB), leaving out the first ``skip`` seconds
-        (start-up and configuration)."""
-        if len(self.samples) < 3:
-            raise RuntimeError("too few samples of the EasyNav process")
-        start = self.samples[0][0] + skip
-        kept = [s for s in self.samples if s[0] >= start] or self.samples
-        (w0, c0, _), (w1, c1, _) = kept[0], kept[-1]
-        cpu = 100.0 * (c1 - c0) / max(w1 - w0, 1e-9)
-        rss = [s[2] for s in kept]
-        return cpu, statistics.median(rss), max(rss)
 
 
 def patrol(world: str, minutes: float, lap_estimate: float) -> list[list[float]]:
@@ -110,13 +44,12 @@ def measure(params: Path, world: str, waypoints: list, timeout: float) -> tuple:
     from easynav.playground.demo import run_demo
 
     run_dir = Path(tempfile.mkdtemp(prefix="easynav_bench_stack_"))
-    sampler = Sampler(run_dir)
+    sampler = ProcessSampler(run_dir)
     sampler.start()
     out = io.StringIO()
     code = run_demo(world=world, params_file=params, waypoints=waypoints, output_png=None,
                     timeout=timeout, run_dir=run_dir, stream=out)
-    sampler.stop_event.set()
-    sampler.join()
+    sampler.stop()
     cpu, rss_median, rss_max = sampler.figures()
     reached = out.getvalue().count(" yes ")
     return cpu, rss_median, rss_max, code, reached
