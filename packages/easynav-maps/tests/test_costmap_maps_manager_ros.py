@@ -59,7 +59,7 @@ def test_topics_and_savemap(ros, tmp_path):
     assert first.data[9, 0] == -2 and first.data[0, 0] == 0  # lethal byte 254 as int8
 
     nav_state = NavState()
-    ros.spin_until(lambda: manager._ros["dynamic_map"].get_subscription_count() > 0)
+    ros.spin_until(lambda: manager._ros.get("dynamic_map").get_subscription_count() > 0)
     manager.update(nav_state)
     assert ros.spin_until(lambda: dynamic)
     inflated = occupancy_grid_from_msg(dynamic[-1])
@@ -84,4 +84,4 @@ def test_topics_and_savemap(ros, tmp_path):
     assert np.array_equal(load_costmap_yaml(target).data, manager.base_map.data)
 
     manager.on_cleanup()
-    assert manager._ros == {}
+    assert len(manager._ros) == 0

@@ -41,4 +41,4 @@ def test_markers_and_save_routes(ros, tmp_path):
     assert future.result().success, future.result().message
     assert load_routes_yaml(target) == manager.routes
     manager.on_cleanup()
-    assert manager._ros == {}
+    assert len(manager._ros) == 0

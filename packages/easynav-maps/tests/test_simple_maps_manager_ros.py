@@ -56,7 +56,7 @@ def test_topics_and_savemap(ros, tmp_path):
 
     # dynamic_map is published by update while someone listens.
     nav_state = NavState()
-    ros.spin_until(lambda: manager._ros["dynamic_map"].get_subscription_count() > 0)
+    ros.spin_until(lambda: manager._ros.get("dynamic_map").get_subscription_count() > 0)
     manager.update(nav_state)
     assert ros.spin_until(lambda: dynamic)
 
@@ -79,4 +79,4 @@ def test_topics_and_savemap(ros, tmp_path):
     assert SimpleMap.load(target) == manager.static_map
 
     manager.on_cleanup()
-    assert manager._ros == {}
+    assert len(manager._ros) == 0

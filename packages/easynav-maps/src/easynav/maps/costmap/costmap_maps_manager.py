@@ -10,6 +10,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError, Topic
 from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.discovery import load_plugin_class
+from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D
@@ -96,7 +97,7 @@ class CostmapMapsManager(MapsManagerBase):
         self._save_path = DEFAULT_SAVE_PATH
         self._filters: list[tuple[str, CostmapFilter]] = []
         self._throttle = WarningThrottle(period=5.0)
-        self._ros: dict[str, Any] = {}
+        self._ros = PluginEndpoints()
 
     # -- configuration --------------------------------------------------------------------------
     def on_initialize(self) -> None:
@@ -301,38 +302,17 @@ class CostmapMapsManager(MapsManagerBase):
     # -- ROS ----------------------------------------------------------------------------------
     def _create_ros(self) -> None:
         from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from std_srvs.srv import Trigger
 
-        node = self.context.node
-        base = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}"
-        latched = QoSProfile(
-            depth=1,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
-        )
-        self._ros = {
-            "map": node.create_publisher(OccupancyGridMsg, f"{base}/map", latched),
-            "dynamic_map": node.create_publisher(OccupancyGridMsg, f"{base}/dynamic_map", 100),
-            "incoming_map": node.create_subscription(
-                OccupancyGridMsg, f"{base}/incoming_map", self._on_incoming_map, latched
-            ),
-            "savemap": node.create_service(Trigger, f"{base}/savemap", self._on_savemap),
-        }
+        ros = self._ros = PluginEndpoints(self.context.node, self.plugin_name)
+        ros.publisher("map", OccupancyGridMsg, latched_qos())
+        ros.publisher("dynamic_map", OccupancyGridMsg, 100)
+        ros.subscription("incoming_map", OccupancyGridMsg, self._on_incoming_map, latched_qos())
+        ros.service("savemap", Trigger, self._on_savemap)
         self._publish_base()
 
     def _destroy_ros(self) -> None:
-        node = self.context.node
-        ros, self._ros = self._ros, {}
-        if node is None:
-            return
-        for name, entity in ros.items():
-            if name == "incoming_map":
-                node.destroy_subscription(entity)
-            elif name == "savemap":
-                node.destroy_service(entity)
-            else:
-                node.destroy_publisher(entity)
+        self._ros.destroy()
 
     def _publish_base(self) -> None:
         publisher = self._ros.get("map")

@@ -10,6 +10,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError, Topic
 from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.discovery import load_plugin_class
+from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.tf import get_tf_buffer
 from easynav.maps.map_file_resolver import resolve_map_file
 from easynav.maps.map_format_error import MapFormatError
@@ -70,7 +71,7 @@ class RoutesMapsManager(MapsManagerBase):
         self._routes = RoutesMap.default()
         self._path = DEFAULT_ROUTES_PATH
         self._filters: list[tuple[str, RoutesFilter]] = []
-        self._ros: dict[str, Any] = {}
+        self._ros = PluginEndpoints()
 
     # -- configuration ------------------------------------------------------------------------
     def on_initialize(self) -> None:
@@ -215,33 +216,16 @@ class RoutesMapsManager(MapsManagerBase):
 
     # -- ROS ----------------------------------------------------------------------------------
     def _create_ros(self) -> None:
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from std_srvs.srv import Trigger
         from visualization_msgs.msg import MarkerArray
 
-        node = self.context.node
-        base = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}"
-        latched = QoSProfile(
-            depth=10,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
-        )
-        self._ros = {
-            "routes": node.create_publisher(MarkerArray, f"{base}/routes", latched),
-            "save_routes": node.create_service(Trigger, f"{base}/save_routes", self._on_save),
-        }
+        ros = self._ros = PluginEndpoints(self.context.node, self.plugin_name)
+        ros.publisher("routes", MarkerArray, latched_qos(depth=10))
+        ros.service("save_routes", Trigger, self._on_save)
         self._publish_markers()
 
     def _destroy_ros(self) -> None:
-        node = self.context.node
-        ros, self._ros = self._ros, {}
-        if node is None:
-            return
-        for name, entity in ros.items():
-            if name == "save_routes":
-                node.destroy_service(entity)
-            else:
-                node.destroy_publisher(entity)
+        self._ros.destroy()
 
     def _publish_markers(self) -> None:
         publisher = self._ros.get("routes")

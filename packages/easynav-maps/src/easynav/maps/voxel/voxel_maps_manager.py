@@ -11,6 +11,7 @@ import numpy as np
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
+from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.tf import ExtrapolationError, TransformError, get_tf_buffer
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
@@ -297,20 +298,14 @@ class VoxelMapsManager(CostmapMapsManager):
     # -- ROS ------------------------------------------------------------------------------------
     def _create_ros(self) -> None:
         from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import PointCloud2
         from std_srvs.srv import Trigger
 
-        node = self.context.node
-        base = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}"
-        latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self._ros = {
-            "cloud": node.create_publisher(PointCloud2, f"{base}/map", latched),
-            "map": node.create_publisher(OccupancyGridMsg, f"{base}/projected_map", latched),
-            "dynamic_map": node.create_publisher(OccupancyGridMsg, f"{base}/dynamic_map", 100),
-            "savemap": node.create_service(Trigger, f"{base}/savemap", self._on_savemap),
-        }
+        ros = self._ros = PluginEndpoints(self.context.node, self.plugin_name)
+        ros.publisher("cloud", PointCloud2, latched_qos(), topic="map")
+        ros.publisher("map", OccupancyGridMsg, latched_qos(), topic="projected_map")
+        ros.publisher("dynamic_map", OccupancyGridMsg, 100)
+        ros.service("savemap", Trigger, self._on_savemap)
         self._publish_base()
         self._cloud_dirty = True
 
