@@ -1,0 +1,122 @@
+"""Keepout and speed zones of the costmap stack (issue #14), end to end in the playground.
+
+``params/costmap.zones.params.yaml`` on the depot: a KeepoutFilter zone lies on the straight line
+from the start to the tour's first waypoint, a SpeedFilter zone (30 % of the maximum speed)
+covers the north-east corner around the fourth waypoint. From the playground's ground truth:
+every waypoint reached, no collision, localisation error below 0.1 m, the robot's body never
+inside the keepout zone, and its true speed within the zone's limit while it is inside the speed
+zone. (This is the costmap stack's depot run: test_costmap_stack_scenario.py runs tb3_sandbox.)
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from easynav.playground.demo import run_demo
+from easynav.playground.sim import GroundTruthRecorder
+from easynav.playground.world_description import WorldDescription
+
+pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(900)]
+
+PARAMS = Path(__file__).resolve().parents[3] / "params" / "costmap.zones.params.yaml"
+MASKS = Path(__file__).resolve().parents[1] / "src" / "easynav" / "playground" / "worlds" / "maps"
+
+KEEPOUT = (4.5, 7.5, 5.5, 8.5)  # x0, x1, y0, y1 of depot_keepout.yaml's zone (m)
+SPEED_ZONE = (23.0, 10.0)  # x >= 23 m and y >= 10 m: depot_speed.yaml's zone
+SPEED_PERCENT = 30
+# Inside the speed zone the limit holds once the robot has slowed down: the SpeedFilter reads the
+# estimated pose at the maps manager's 10 Hz and the velocity output decelerates at
+# max_linear_decel (1 m/s², from 0.5 m/s to 0.15 m/s in 0.35 s, about 0.12 m). So the speed is
+# checked where the true centre is at least 0.5 m inside the zone's edge (those delays plus the
+# localisation error, < 0.1 m).
+EDGE_MARGIN = 0.5
+# The true speed is a finite difference of the ground-truth positions over 0.2 s windows.
+SPEED_WINDOW = 0.2
+
+
+def distance_to_box(x: np.ndarray, y: np.ndarray, box: tuple[float, float, float, float]):
+    """Distance from each point to the axis-aligned box (0 inside)."""
+    x0, x1, y0, y1 = box
+    dx = np.maximum(np.maximum(x0 - x, 0.0), x - x1)
+    dy = np.maximum(np.maximum(y0 - y, 0.0), y - y1)
+    return np.hypot(dx, dy)
+
+
+def true_speeds(true_poses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(x, y, speed)`` at the middle of each SPEED_WINDOW of the true trajectory."""
+    t, x, y = true_poses[:, 0], true_poses[:, 1], true_poses[:, 2]
+    ends = np.searchsorted(t, t + SPEED_WINDOW)
+    keep = ends < len(t)
+    i, j = np.nonzero(keep)[0], ends[keep]
+    speed = np.hypot(x[j] - x[i], y[j] - y[i]) / (t[j] - t[i])
+    return (x[i] + x[j]) / 2.0, (y[i] + y[j]) / 2.0, speed
+
+
+def test_the_masks_say_what_the_scenario_assumes():
+    from easynav.maps.costmap.filter_mask import FilterMask
+
+    keepout = FilterMask.load("", str(MASKS / "depot_keepout.yaml"))
+    speed = FilterMask.load("", str(MASKS / "depot_speed.yaml"))
+    x0, x1, y0, y1 = KEEPOUT
+    assert keepout.value_at((x0 + x1) / 2, (y0 + y1) / 2) == 100
+    assert keepout.value_at(x0 - 0.05, y0 + 1.0) == 0 and keepout.value_at(x1 + 0.05, y1) == 0
+    waypoints = yaml.safe_load(WorldDescription.resolve("depot").waypoints_path.read_text())
+    first = waypoints["waypoints"][0]
+    start = WorldDescription.resolve("depot").start_pose
+    middle = ((start[0] + first[0]) / 2, (start[1] + first[1]) / 2)
+    assert keepout.value_at(*middle) == 100, "the zone must lie on the straight first leg"
+    fourth = waypoints["waypoints"][3]
+    assert speed.value_at(fourth[0], fourth[1]) == SPEED_PERCENT
+    assert speed.value_at(SPEED_ZONE[0] - 0.1, 12.0) == 0
+    assert speed.value_at(25.0, SPEED_ZONE[1] - 0.1) == 0
+
+
+def test_the_robot_goes_around_the_keepout_zone_and_slows_in_the_speed_zone(tmp_path):
+    out = io.StringIO()
+    code = run_demo(
+        world="depot",
+        params_file=PARAMS,
+        speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "1.0")),
+        output_png=tmp_path / "demo.png",
+        timeout=900.0,
+        domain_id=int(os.environ["ROS_DOMAIN_ID"]),  # reserved for this test process
+        run_dir=tmp_path / "run",
+        stream=out,
+    )
+    report = out.getvalue()
+    assert code == 0, report
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["reached"] == summary["waypoints"] == 6, report
+    assert summary["collisions"] == 0, report
+
+    run = GroundTruthRecorder.load(tmp_path / "run" / "run.json")
+    errors = run.localisation_errors()
+    assert errors.size > 100, "EasyNav's pose estimate was not seen on /tf"
+    assert float(errors.max()) < 0.1, report
+    true_poses = np.array(run.true_poses)
+    radius = WorldDescription.resolve("depot").robot.radius
+    # The keepout filter runs before the inflation: the inscribed zone keeps the robot's centre
+    # a radius away from the zone, up to the costmap's 0.05 m cells.
+    clearance = distance_to_box(true_poses[:, 1], true_poses[:, 2], KEEPOUT)
+    assert clearance.min() >= radius - 0.05, (
+        f"the robot's body entered the keepout zone: centre {clearance.min():.3f} m from it"
+    )
+
+    x, y, speed = true_speeds(true_poses)
+    inside = (x >= SPEED_ZONE[0] + EDGE_MARGIN) & (y >= SPEED_ZONE[1] + EDGE_MARGIN)
+    assert inside.sum() > 20, "the tour did not cross the speed zone"
+    max_linear_vel = yaml.safe_load(PARAMS.read_text())["controller_node"]["ros__parameters"][
+        "robot_limits"]["max_linear_vel"]
+    limit = max_linear_vel * SPEED_PERCENT / 100.0
+    assert speed[inside].max() <= limit + 1e-3, (
+        f"{speed[inside].max():.3f} m/s inside the speed zone (limit {limit:.3f} m/s)"
+    )
+    # Outside the zone the robot is not held to it (the zone, not a slow robot, did this).
+    assert speed[~inside].max() > 2 * limit
