@@ -96,6 +96,27 @@ def test_goal_manager_tolerances_tighten_the_stop():
     assert abs(math.remainder(yaw - math.pi / 2, 2 * math.pi)) <= 0.01
 
 
+def test_a_robot_held_for_minutes_does_not_circle_its_goal_once_released():
+    # Held (a protective stop, a person blocking it) while the follower keeps computing: the
+    # error stands for minutes. Before the integrals were bounded by the robot limits, they
+    # wound up and the released robot circled its goal at full speed and full turn for ever
+    # (seen on the campus: 20 minutes at (0.7 m/s, -1 rad/s) around a waypoint).
+    limits = RobotLimits(max_linear_vel=0.7, max_angular_vel=1.0, max_linear_acc=0.5,
+                         max_linear_decel=1.0, max_angular_acc=1.0, max_angular_decel=2.0)
+    follower = SimplePathFollower(look_ahead_dist=1.0, tolerance_dist=0.05)
+    goal = (2.0, 1.0, 1.0)
+    path = np.column_stack((np.linspace(0.0, goal[0], 15), np.linspace(0.0, goal[1], 15),
+                            np.full(15, goal[2])))
+    for _ in range(int(300 / (1 / 30))):  # five minutes held at the start, facing away
+        follower.compute((0.0, 0.0, math.pi), path, 1 / 30, limits)
+    # Bounded: the integral terms never ask for more than the robot can do.
+    assert abs(follower.linear_pid.ki * follower.linear_pid._integral) <= 0.7 + 1e-9
+    assert abs(follower.angular_pid.ki * follower.angular_pid._integral) <= 1.0 + 1e-9
+    trace, states = simulate(follower, path, (0.0, 0.0, math.pi), limits=limits, seconds=40.0)
+    assert states[-1] == ARRIVED, "the released robot did not reach its goal"
+    assert math.hypot(trace[-1, 0] - goal[0], trace[-1, 1] - goal[1]) <= 0.05
+
+
 def test_accelerations_are_respected():
     limits = RobotLimits(max_linear_vel=0.5, max_linear_acc=0.25, max_angular_acc=0.5)
     follower = SimplePathFollower(look_ahead_dist=0.6)

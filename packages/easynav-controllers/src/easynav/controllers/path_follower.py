@@ -131,7 +131,8 @@ class SimplePathFollower:
         self.k_rot = float(k_rot)
         self.allow_reversing = bool(allow_reversing)
         self.cusp_tolerance = float(cusp_tolerance)
-        # Outputs are saturated later by the robot limits; the PIDs only clamp their integral.
+        # Outputs are saturated later by the robot limits; each compute() bounds the integral
+        # terms by those limits (anti-windup).
         self.linear_pid = PIDController(*linear_gains, max_output=math.inf)
         self.angular_pid = PIDController(*angular_gains, max_output=math.inf)
         self._v = 0.0
@@ -209,6 +210,10 @@ class SimplePathFollower:
         ):
             self._goal = goal  # a new goal: decide the final approach afresh
             self._final_rotation = False
+        # Anti-windup: the integral terms may never ask for more than the robot can do (the
+        # PIDs' outputs are saturated below, by these same limits).
+        self.linear_pid.integral_limit = max(limits.max_linear_vel, 0.0)
+        self.angular_pid.integral_limit = max(limits.max_angular_vel, 0.0)
         stop_dist = min(self.tolerance_dist, position_tolerance)
         stop_yaw = min(self.final_goal_angle_tolerance, yaw_tolerance)
         dist_goal = math.hypot(goal[0] - x, goal[1] - y)
@@ -225,6 +230,10 @@ class SimplePathFollower:
         if on_last and (
             dist_goal <= stop_dist or (self._final_rotation and dist_goal <= 2.0 * stop_dist)
         ):
+            if not self._final_rotation:
+                # A new objective (the goal's yaw, not the carrot's bearing): the heading
+                # integral of the approach must not push the final turn.
+                self.angular_pid.reset()
             self._final_rotation = True
             self.linear_pid.reset()
             if abs(yaw_error) <= stop_yaw:
