@@ -385,3 +385,58 @@ def test_bonxai_manager_loads_a_pcd_and_saves_it(tmp_path):
 def test_manager_missing_file_names_the_parameter(tmp_path):
     with pytest.raises(PluginConfigurationError, match="occmap_path_file"):
         make_manager(BonxaiMapsManager, {"occmap_path_file": str(tmp_path / "none.yaml")})
+
+
+def _voxel_manager_class(name):
+    if name == "octomap":
+        pytest.importorskip("pyoctomap")
+        from easynav.maps.voxel.octomap_maps_manager import OctomapMapsManager
+
+        return OctomapMapsManager
+    return BonxaiMapsManager
+
+
+@pytest.mark.parametrize("manager_class", ["bonxai", "octomap"])
+def test_an_incoming_grid_replaces_the_voxel_map(tmp_path, manager_class):
+    manager = make_manager(_voxel_manager_class(manager_class),
+                           {"occmap_path_file": str(room_yaml(tmp_path))})
+    nav_state = NavState()
+    manager.update(nav_state)
+    assert nav_state.get(MAP_BASE).cost_at(0.02, 1.0) == 254  # the room's west wall
+    # What incoming_occ_map carries: another grid, 2 x 1 m at 0.1 m, a wall across x = 1.0.
+    data = np.zeros((10, 20), dtype=np.uint8)
+    data[:, 10] = 254
+    manager.replace_from_grid(Costmap2D(data, 0.1, 5.0, 5.0))
+    manager.update(nav_state)
+    base = nav_state.get(MAP_BASE)
+    assert (base.width, base.height, base.origin_x) == (20, 10, 5.0)
+    assert base.cost_at(6.05, 5.5) == 254 and base.cost_at(5.55, 5.5) == 0
+    assert nav_state.get(MAP).cost_at(6.05, 5.5) == 254
+    if manager_class == "bonxai":  # the original Bonxai's rule: the grid's resolution wins
+        assert manager.voxel_map.resolution == pytest.approx(0.1)
+    # The old room is gone: its wall is not in the new voxel map.
+    centres = manager.voxel_map.occupied_centres()
+    assert not np.any(np.hypot(centres[:, 0] - 0.02, centres[:, 1] - 1.0) < 0.2)
+
+
+@pytest.mark.parametrize("manager_class", ["bonxai", "octomap"])
+def test_an_incoming_cloud_replaces_the_voxel_map_and_clears_along_its_beams(tmp_path,
+                                                                             manager_class):
+    manager = make_manager(_voxel_manager_class(manager_class), {
+        "occmap_path_file": str(room_yaml(tmp_path)), "resolution": 0.1})
+    nav_state = NavState()
+    manager.update(nav_state)
+    # A wall 2 m east of a sensor at (0.5, 1.5, 0.3), seen through a column of beams.
+    ys = np.arange(1.0, 2.01, 0.05)
+    zs = np.arange(0.15, 0.46, 0.05)
+    wall = np.array([[2.5, y, z] for y in ys for z in zs])
+    manager.replace_from_cloud(wall, np.array([0.5, 1.5, 0.3]))
+    manager.update(nav_state)
+    base = nav_state.get(MAP_BASE)
+    assert base.cost_at(2.52, 1.5) == 254      # the wall
+    assert base.cost_at(1.5, 1.5) == 0         # along the beams: free
+    assert base.cost_at(2.52, 1.0) == 254 and base.cost_at(2.52, 2.0) == 254
+    # The room's walls are gone: the map is the cloud's (plus projection_margin around it).
+    assert not np.any(manager.voxel_map.occupied_centres()[:, 0] < 2.0)
+    with pytest.raises(ValueError, match="no finite point"):
+        manager.replace_from_cloud(np.full((3, 3), np.nan), None)

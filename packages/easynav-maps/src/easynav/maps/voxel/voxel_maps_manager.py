@@ -13,6 +13,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
+from easynav.core.sensors.point_perceptions_ops import transform_points
 from easynav.core.tf import ExtrapolationError, TransformError, get_tf_buffer
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
 from easynav.maps.costmap.costmap_maps_manager import CostmapMapsManager
@@ -87,6 +88,12 @@ class VoxelMapsManager(CostmapMapsManager):
               "the 2D projection of the loaded map (map.base)"),
         Topic("<alias>/dynamic_map", "nav_msgs/msg/OccupancyGrid", "pub", "reliable, depth 100",
               "map after the filters (cost bytes as is, 255 → -1)"),
+        Topic("<alias>/incoming_pc2_map", "sensor_msgs/msg/PointCloud2", "sub",
+              "reliable, depth 100",
+              "a cloud that replaces the voxel map (transformed to the map frame; beams cast "
+              "from the cloud frame's origin)"),
+        Topic("<alias>/incoming_occ_map", "nav_msgs/msg/OccupancyGrid", "sub", "latched",
+              "a grid that replaces the voxel map (occupied cells extruded to wall_height)"),
     )
     READS = (MAP_BASE,)
     WRITES = (MAP_BASE, MAP, MAP_TIME, MAP_OBSTACLE_BOUNDS)
@@ -160,15 +167,7 @@ class VoxelMapsManager(CostmapMapsManager):
                     "empty or hold nothing): the 2D projection waits for map.base"
                 )
         if grid is not None:
-            base = Costmap2D(np.zeros_like(grid.data), grid.resolution, grid.origin_x,
-                             grid.origin_y, frame, float(self.now()))
-            ix, iy = project_keys(self._voxels.band_keys(), self._voxels.resolution, base)
-            base.data[iy, ix] = LETHAL_OBSTACLE
-            self._base = base
-            self.logger.info(
-                f"{alias}: voxel map at {self._voxels.resolution} m, 2D projection "
-                f"{base.width}x{base.height} cells ({len(ix)} lethal)"
-            )
+            self._project_base(grid)
         if p.save_map_path:
             self._save_path = p.save_map_path
         elif self._map_file is not None and not p.package:
@@ -189,6 +188,20 @@ class VoxelMapsManager(CostmapMapsManager):
         except (FileNotFoundError, ValueError) as exc:
             raise FileNotFoundError(f"{self.plugin_name}.{name}: {exc}") from None
 
+    def _project_base(self, grid: Costmap2D) -> None:
+        """``map.base``: the voxel map's band projected on ``grid``'s cells."""
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
+        base = Costmap2D(np.zeros_like(grid.data), grid.resolution, grid.origin_x,
+                         grid.origin_y, frame, float(self.now()))
+        ix, iy = project_keys(self._voxels.band_keys(), self._voxels.resolution, base)
+        base.data[iy, ix] = LETHAL_OBSTACLE
+        self._base = base
+        self._cloud_dirty = True
+        self.logger.info(
+            f"{self.plugin_name}: voxel map at {self._voxels.resolution} m, 2D projection "
+            f"{base.width}x{base.height} cells ({len(ix)} lethal)"
+        )
+
     # -- public API -----------------------------------------------------------------------------
     @property
     def voxel_map(self) -> Any:
@@ -202,6 +215,44 @@ class VoxelMapsManager(CostmapMapsManager):
         if len(points):
             self._voxels.insert_point_cloud(points, origin, self.params.max_range)
             self._cloud_dirty = True
+
+    def replace_from_grid(self, grid: Costmap2D) -> None:
+        """A new voxel map from an occupancy grid: its occupied cells extruded to
+        ``wall_height`` (its resolution replaces the map's where ``OCCMAP_SETS_RESOLUTION``), as
+        ``occmap_path_file`` does at configure; ``map.base`` is the projection over ``grid``.
+        Non-RT thread. Raises ImportError when the voxel library is missing."""
+        p = self.params
+        resolution = grid.resolution if self.OCCMAP_SETS_RESOLUTION else self._voxels.resolution
+        voxels = self._new_voxel_map(resolution)
+        voxels.set_band(p.min_z, self.get_robot_geometry().height)
+        voxels.set_occupied(extrude_costmap(grid, p.wall_height, voxels.resolution))
+        self._voxels = voxels
+        self._project_base(grid)
+        self._publish_base()
+
+    def replace_from_cloud(self, points: np.ndarray, origin: np.ndarray | None) -> None:
+        """A new voxel map from a map-frame cloud ``(N, 3)``, at the same resolution: seen from
+        ``origin`` the beams are cast (free space cleared, ends hit), without one every point is
+        an occupied voxel; ``map.base`` is the projection over the cloud plus
+        ``projection_margin``. Non-RT thread. Raises ValueError for an empty cloud."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        points = points[np.isfinite(points).all(axis=1)]
+        if len(points) == 0:
+            raise ValueError("the cloud has no finite point")
+        p = self.params
+        voxels = self._new_voxel_map(self._voxels.resolution)
+        voxels.set_band(p.min_z, self.get_robot_geometry().height)
+        if origin is None:
+            voxels.set_occupied(points)
+        else:
+            voxels.insert_point_cloud(points, origin, math.inf)
+        self._voxels = voxels
+        frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
+        grid = grid_around(voxels.occupied_centres(), voxels.resolution, p.projection_margin,
+                           frame)
+        if grid is not None:
+            self._project_base(grid)
+            self._publish_base()
 
     def save_map(self) -> tuple[bool, str]:
         """Write the voxel map to :attr:`save_path`; ``(success, message)``."""
@@ -305,9 +356,49 @@ class VoxelMapsManager(CostmapMapsManager):
         ros.publisher("cloud", PointCloud2, latched_qos(), topic="map")
         ros.publisher("map", OccupancyGridMsg, latched_qos(), topic="projected_map")
         ros.publisher("dynamic_map", OccupancyGridMsg, 100)
+        ros.subscription("incoming_pc2_map", PointCloud2, self._on_incoming_cloud, 100)
+        ros.subscription("incoming_occ_map", OccupancyGridMsg, self._on_incoming_grid,
+                         latched_qos())
         ros.service("savemap", Trigger, self._on_savemap)
         self._publish_base()
         self._cloud_dirty = True
+
+    def _on_incoming_cloud(self, msg) -> None:
+        """incoming_pc2_map: the map rebuilt from the cloud, in the map frame (non-RT thread)."""
+        from easynav.core.sensors.converters.point_cloud2 import points_from_point_cloud2
+
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        frame = msg.header.frame_id
+        try:
+            points, _ = points_from_point_cloud2(msg)
+            buffer = get_tf_buffer(self.context.namespace)
+            map_frame = buffer.get_tf_info().map_frame
+            origin = None
+            if frame and frame.lstrip("/") != map_frame.lstrip("/"):
+                try:
+                    _, values = buffer.lookup_transform_values(map_frame, frame, stamp)
+                except ExtrapolationError:
+                    _, values = buffer.lookup_transform_values(map_frame, frame, None)
+                points = transform_points(np.asarray(points, dtype=np.float64), values)
+                origin = np.array(values[:3], dtype=np.float64)
+            self.replace_from_cloud(points, origin)
+        except (TransformError, ValueError) as exc:
+            self.logger.error(f"{self.plugin_name}: incoming_pc2_map rejected, map kept: {exc}")
+            return
+        self.logger.info(f"{self.plugin_name}: voxel map rebuilt from incoming_pc2_map "
+                         f"({len(points)} points in '{frame}')")
+
+    def _on_incoming_grid(self, msg) -> None:
+        """incoming_occ_map: the map rebuilt from the grid, extruded (non-RT thread)."""
+        from easynav.maps.costmap_io import costmap_from_occupancy_grid
+        from easynav.maps.ros_converters import occupancy_grid_from_msg
+
+        try:
+            self.replace_from_grid(costmap_from_occupancy_grid(occupancy_grid_from_msg(msg)))
+        except ValueError as exc:
+            self.logger.error(f"{self.plugin_name}: incoming_occ_map rejected, map kept: {exc}")
+            return
+        self.logger.info(f"{self.plugin_name}: voxel map rebuilt from incoming_occ_map")
 
     def _publish_cloud(self) -> None:
         publisher = self._ros.get("cloud")
