@@ -440,3 +440,26 @@ def test_an_incoming_cloud_replaces_the_voxel_map_and_clears_along_its_beams(tmp
     assert not np.any(manager.voxel_map.occupied_centres()[:, 0] < 2.0)
     with pytest.raises(ValueError, match="no finite point"):
         manager.replace_from_cloud(np.full((3, 3), np.nan), None)
+
+
+def test_ply_ascii_and_binary_read_back_their_vertices(tmp_path):
+    from easynav.maps.map_format_error import MapFormatError
+    from easynav.maps.voxel.voxel_sources import read_point_cloud
+
+    points = np.array([[1.0, 2.0, 0.3], [-1.5, 0.25, 1.0], [3.0, -2.0, 0.05]])
+    header = ("ply\nformat {fmt} 1.0\ncomment a mesh\nelement vertex 3\nproperty float x\n"
+              "property float y\nproperty float z\nproperty uchar red\nelement face 1\n"
+              "property list uchar int vertex_indices\nend_header\n")
+    rows = "".join(f"{x} {y} {z} 255\n" for x, y, z in points) + "3 0 1 2\n"
+    (tmp_path / "a.ply").write_text(header.format(fmt="ascii") + rows)
+    np.testing.assert_allclose(read_point_cloud(tmp_path / "a.ply"), points, atol=1e-6)
+    vertex = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("red", "u1")])
+    data = np.array([(x, y, z, 255) for x, y, z in points], dtype=vertex)
+    (tmp_path / "b.ply").write_bytes(header.format(fmt="binary_little_endian").encode()
+                                     + data.tobytes() + bytes([3, 0, 0, 0, 0, 1, 0, 0, 0, 2, 0,
+                                                               0, 0]))
+    np.testing.assert_allclose(read_point_cloud(tmp_path / "b.ply"), points, atol=1e-6)
+    (tmp_path / "c.ply").write_text("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                                    "end_header\n1\n2\n")
+    with pytest.raises(MapFormatError, match="c.ply: PLY vertices need scalar x, y and z"):
+        read_point_cloud(tmp_path / "c.ply")

@@ -1,5 +1,6 @@
 """Where a voxel map starts from: an occupancy grid extruded to a wall height, or a point cloud
-file (PCD read and written here; PLY and compressed PCD through open3d, an optional extra).
+file (PCD and PLY read here, PCD written; compressed PCD and other formats through open3d, an
+optional extra).
 
 Pure functions, any thread. Exceptions name the file.
 """
@@ -113,12 +114,74 @@ def write_pcd(path: str | os.PathLike, points: np.ndarray) -> Path:
     return path
 
 
+_PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2",
+              "int16": "i2", "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4",
+              "uint": "u4", "uint32": "u4", "float": "f4", "float32": "f4", "double": "f8",
+              "float64": "f8"}
+
+
+def read_ply(path: str | os.PathLike) -> np.ndarray:
+    """``(N, 3)`` float64 finite points: the ``x y z`` of the ``vertex`` element of a PLY file
+    (``ascii``, ``binary_little_endian`` or ``binary_big_endian``; other elements, such as
+    faces, may follow and are ignored). Raises :class:`MapFormatError` naming the file."""
+    path = Path(path)
+    raw = path.read_bytes()
+    end = raw.find(b"end_header")
+    if not raw.startswith(b"ply") or end < 0:
+        raise MapFormatError(f"{path}: not a PLY file (no 'ply' ... 'end_header' header)")
+    body = raw[raw.index(b"\n", end) + 1:]
+    fmt, elements, current = None, [], None
+    for line in raw[:end].decode("ascii", "replace").splitlines()[1:]:
+        words = line.split()
+        if not words or words[0] in ("comment", "obj_info"):
+            continue
+        if words[0] == "format":
+            fmt = words[1]
+        elif words[0] == "element":
+            current = (words[1], int(words[2]), [])
+            elements.append(current)
+        elif words[0] == "property" and current is not None:
+            if words[1] == "list":
+                current[2].append((words[-1], None))
+            elif words[1] in _PLY_TYPES:
+                current[2].append((words[2], _PLY_TYPES[words[1]]))
+            else:
+                raise MapFormatError(f"{path}: unknown PLY property type {words[1]!r}")
+    if not elements or elements[0][0] != "vertex":
+        raise MapFormatError(f"{path}: the first PLY element must be 'vertex'")
+    _, count, properties = elements[0]
+    names = [name for name, _ in properties]
+    if not {"x", "y", "z"} <= set(names) or any(t is None for _, t in properties):
+        raise MapFormatError(f"{path}: PLY vertices need scalar x, y and z properties")
+    if fmt == "ascii":
+        rows = body.decode("ascii", "replace").split("\n")[:count]
+        try:
+            table = np.array([row.split()[: len(names)] for row in rows], dtype=np.float64)
+        except ValueError:
+            raise MapFormatError(f"{path}: malformed PLY vertex rows") from None
+        if table.shape != (count, len(names)):
+            raise MapFormatError(f"{path}: {count} vertices announced, fewer found")
+        columns = {name: table[:, i] for i, name in enumerate(names)}
+    elif fmt in ("binary_little_endian", "binary_big_endian"):
+        order = "<" if fmt == "binary_little_endian" else ">"
+        dtype = np.dtype([(name, order + t) for name, t in properties])
+        if len(body) < count * dtype.itemsize:
+            raise MapFormatError(f"{path}: {count} vertices announced, the data is shorter")
+        columns = np.frombuffer(body, dtype=dtype, count=count)
+    else:
+        raise MapFormatError(f"{path}: unknown PLY format {fmt!r}")
+    xyz = np.column_stack([np.asarray(columns[k], dtype=np.float64) for k in ("x", "y", "z")])
+    return xyz[np.isfinite(xyz).all(axis=1)]
+
+
 def read_point_cloud(path: str | os.PathLike) -> np.ndarray:
-    """``(N, 3)`` points of a PCD (native, or open3d for compressed data) or any file open3d
-    reads (PLY, XYZ, PTS). Raises :class:`FileNotFoundError` or :class:`MapFormatError`."""
+    """``(N, 3)`` points of a PCD (native, or open3d for compressed data), a PLY (native) or any
+    file open3d reads (XYZ, PTS). Raises :class:`FileNotFoundError` or :class:`MapFormatError`."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"{path}: no such point cloud file")
+    if path.suffix.lower() == ".ply":
+        return read_ply(path)
     if path.suffix.lower() == ".pcd":
         try:
             return read_pcd(path)
