@@ -18,7 +18,7 @@ class BonxaiMapsManager(VoxelMapsManager):
     """A :class:`BonxaiMap` (Bonxai-style sparse probabilistic voxels) fed by the point
     perceptions, with the 2D projection of :class:`VoxelMapsManager`.
 
-    Parameters: the original's ``package``, ``bonxai_path_file`` (a PCD, or PLY with open3d:
+    Parameters: the original's ``package``, ``bonxai_path_file`` (a PCD or PLY:
     every point an occupied voxel), ``occmap_path_file`` (a map_server YAML: occupied cells
     extruded to ``wall_height``; its resolution replaces ``resolution``; free cells add nothing,
     where the original added a floor voxel at z 0, which the projection would drop anyway) and
@@ -34,7 +34,7 @@ class BonxaiMapsManager(VoxelMapsManager):
     MAP_FILE_PARAMETER = "bonxai_path_file"
     DEFAULT_SAVE_NAME = "easynav_bonxai.pcd"
     PARAMETERS = (
-        Param("bonxai_path_file", "", "point cloud (PCD; PLY with open3d) of occupied voxels"),
+        Param("bonxai_path_file", "", "point cloud (PCD or PLY) of occupied voxels"),
         Param("resolution", 0.3, "voxel edge (replaced by occmap_path_file's resolution)", "m",
               gt=0.0),
         *COMMON_PARAMETERS,

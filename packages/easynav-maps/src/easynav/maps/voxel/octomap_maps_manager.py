@@ -21,7 +21,7 @@ class OctomapMapsManager(VoxelMapsManager):
     The original's manager is a stub (no parameters, nothing updated; CATALOGUE §7); this one
     works under its name with the original's tree settings (resolution 0.3 m, hit 0.7, miss 0.4,
     clamping 0.12–0.97). Parameters: ``octomap_path_file`` (an OctoMap binary ``.bt``, or a
-    point cloud: PCD, PLY with open3d), ``resolution`` and those of :class:`VoxelMapsManager`
+    point cloud: PCD or PLY), ``resolution`` and those of :class:`VoxelMapsManager`
     (``package``, ``occmap_path_file`` extruded to ``wall_height`` at ``resolution``: unlike
     Bonxai's, the grid's resolution does not replace it, see ``OCCMAP_SETS_RESOLUTION``).
 
@@ -39,7 +39,7 @@ class OctomapMapsManager(VoxelMapsManager):
     OCCMAP_SETS_RESOLUTION = False
     DEFAULT_SAVE_NAME = "easynav_octomap.bt"
     PARAMETERS = (
-        Param("octomap_path_file", "", "OctoMap .bt, or a point cloud (PCD; PLY with open3d)"),
+        Param("octomap_path_file", "", "OctoMap .bt, or a point cloud (PCD or PLY)"),
         Param("resolution", 0.3, "voxel edge (an occmap_path_file is extruded at it)", "m",
               gt=0.0),
         *COMMON_PARAMETERS,
