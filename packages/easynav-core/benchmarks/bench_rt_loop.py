@@ -9,7 +9,9 @@ Runs, one after the other for ``--duration`` seconds each, at 200 Hz:
 3. the Dummy system of the seed (params/dummy.params.yaml, on wall-clock time), whose Dummy
    plugins busy-wait (1 ms per RT update; 10, 100 and 200 ms per non-RT update);
 4. the same without busy-waits;
-5. (4) with Python's default GIL switch interval (5 ms) instead of EasyNav's 0.5 ms;
+5. (3) with a GIL switch interval of 0.1 ms instead of EasyNav's 0.5 ms: the Dummy plugins'
+   busy-waits are Python loops that hold the GIL, so the RT thread waits for the next switch;
+   (4) with Python's default switch interval (5 ms);
 6. (4) with the cyclic garbage collector disabled (EasyNav only freezes it at activation);
 7. (4) with the non-RT loop's thread back to SCHED_OTHER, as before issue #11 (with
    ``use_real_time`` EasyNav makes it SCHED_FIFO 70; root only), then also at nice -10: a thread
@@ -217,6 +219,7 @@ def main() -> int:
 
     variants = (
         ("EasyNav, seed Dummy (busy-waits)", True, "0.0005", False),
+        ("  same, switch interval 0.1 ms", True, "0.0001", False),
         ("EasyNav, Dummy without busy-waits", False, "0.0005", False),
         ("  same, switch interval 5 ms", False, "0.005", False),
         ("  same, garbage collector off", False, "0.0005", True),
