@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import io
-import os
 from pathlib import Path
 
 import pytest
 
-demo = pytest.importorskip("easynav.playground.demo")
+mission_run = pytest.importorskip("easynav.playground.demo.mission_run")
 
 pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(900)]
 
@@ -17,17 +15,8 @@ PARAMS = Path(__file__).resolve().parents[3] / "params"
 
 @pytest.mark.parametrize("controller", ["mpc", "serest", "vff"])
 def test_home_tour_without_collision(controller, tmp_path):
-    out = io.StringIO()
-    code = demo.run_demo(
-        world="home",
-        params_file=PARAMS / f"costmap.{controller}.params.yaml",
-        speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "1.0")),
-        output_png=tmp_path / "demo.png",
-        timeout=500.0,
-        domain_id=int(os.environ["ROS_DOMAIN_ID"]),
-        run_dir=tmp_path / "run",
-        stream=out,
-    )
-    report = out.getvalue()
-    assert code == 0, report
+    mission = mission_run.MissionRun.run(
+        tmp_path, "home", PARAMS / f"costmap.{controller}.params.yaml", timeout=500.0)
+    report = mission.report
+    assert mission.code == 0, report
     assert "waypoints reached:    4 of 4" in report and "collisions:           0" in report

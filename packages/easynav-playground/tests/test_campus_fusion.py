@@ -6,16 +6,13 @@ Measured here (load ~25 on 2 cores, speed-up 2): UKF mean 0.107 m, max 0.348 m; 
 
 from __future__ import annotations
 
-import io
-import os
 from pathlib import Path
 
 import pytest
 
 pytest.importorskip("pyproj")
 
-from easynav.playground.demo import run_demo  # noqa: E402
-from easynav.playground.sim import GroundTruthRecorder  # noqa: E402
+from easynav.playground.demo.mission_run import MissionRun  # noqa: E402
 
 pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(900)]
 
@@ -28,22 +25,13 @@ def test_outdoor_localizer_drives_the_campus_tour(tmp_path, params, library):
     params_file = PARAMS / f"{params}.params.yaml"
     if not params_file.is_file():
         pytest.skip("the repository's params/ is not here")
-    out = io.StringIO()
-    code = run_demo(
-        world="campus",
-        params_file=params_file,
-        # x2: the tour is ~10 simulated minutes; at x2 it fits the test's time with room (the
-        # figures above were measured at x2 on a loaded machine).
-        speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "2.0")),
-        output_png=tmp_path / "campus.png",
-        timeout=800.0,
-        domain_id=int(os.environ["ROS_DOMAIN_ID"]),
-        run_dir=tmp_path / "run",
-        stream=out,
-    )
-    report = out.getvalue()
-    assert code == 0, report
+    # x2: the tour is ~10 simulated minutes; at x2 it fits the test's time with room (the
+    # figures above were measured at x2 on a loaded machine).
+    mission = MissionRun.run(tmp_path, "campus", params_file, timeout=800.0, speed_up=2.0,
+                             picture="campus.png")
+    report = mission.report
+    assert mission.code == 0, report
     assert "waypoints reached:    5 of 5" in report and "collisions:           0" in report
-    errors = GroundTruthRecorder.load(tmp_path / "run" / "run.json").localisation_errors()
+    errors = mission.truth().localisation_errors()
     assert errors.size > 100, "EasyNav's pose estimate was not seen on /tf"
     assert float(errors.mean()) < 0.5 and float(errors.max()) < 0.5, report

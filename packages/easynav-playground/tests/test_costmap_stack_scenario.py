@@ -7,16 +7,12 @@ world's tour reached, no collision, localisation error below 0.1 m.
 
 from __future__ import annotations
 
-import io
-import json
-import os
 from pathlib import Path
 
 import pytest
 import yaml
 
-from easynav.playground.demo import run_demo
-from easynav.playground.sim import GroundTruthRecorder
+from easynav.playground.demo.mission_run import MissionRun
 from easynav.playground.world_description import WorldDescription
 
 pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(1200)]
@@ -28,30 +24,20 @@ PARAMS = Path(__file__).resolve().parents[3] / "params" / "costmap.params.yaml"
 # (test_costmap_zones_scenario.py): the same checks, and the zones'.
 @pytest.mark.parametrize("world", ["tb3_sandbox"])
 def test_costmap_stack_drives_the_real_map_tour(world, tmp_path):
-    out = io.StringIO()
-    code = run_demo(
-        world=world,
-        params_file=PARAMS,
-        speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "1.0")),
-        output_png=tmp_path / "demo.png",
-        timeout=900.0,
-        domain_id=int(os.environ["ROS_DOMAIN_ID"]),  # reserved for this test process
-        run_dir=tmp_path / "run",
-        stream=out,
-    )
-    report = out.getvalue()
-    assert code == 0, report
+    mission = MissionRun.run(tmp_path, world, PARAMS, timeout=900.0)
+    report = mission.report
+    assert mission.code == 0, report
     # The demo pointed the costmap manager at the world's map and the robot radius at its robot.
-    derived = yaml.safe_load((tmp_path / "run" / "params.yaml").read_text())
+    derived = yaml.safe_load((mission.run_dir / "params.yaml").read_text())
     maps = derived["maps_manager_node"]["ros__parameters"]["costmap"]
     assert maps["package"] == "" and maps["map_path_file"].endswith(f"maps/{world}.yaml")
     radius = WorldDescription.resolve(world).robot.radius
     system = derived["system_node"]["ros__parameters"]
     assert system["robot_geometry"]["radius"] == radius
-    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    summary = mission.summary()
     assert summary["reached"] == summary["waypoints"] >= 6, report
     assert summary["collisions"] == 0, report
-    run = GroundTruthRecorder.load(tmp_path / "run" / "run.json")
+    run = mission.truth()
     errors = run.localisation_errors()
     assert errors.size > 100, "EasyNav's pose estimate was not seen on /tf"
     assert float(errors.max()) < 0.1, report

@@ -10,17 +10,13 @@ zone. (This is the costmap stack's depot run: test_costmap_stack_scenario.py run
 
 from __future__ import annotations
 
-import io
-import json
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
-from easynav.playground.demo import run_demo
-from easynav.playground.sim import GroundTruthRecorder
+from easynav.playground.demo.mission_run import MissionRun
 from easynav.playground.world_description import WorldDescription
 
 pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(900)]
@@ -79,24 +75,14 @@ def test_the_masks_say_what_the_scenario_assumes():
 
 
 def test_the_robot_goes_around_the_keepout_zone_and_slows_in_the_speed_zone(tmp_path):
-    out = io.StringIO()
-    code = run_demo(
-        world="depot",
-        params_file=PARAMS,
-        speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "1.0")),
-        output_png=tmp_path / "demo.png",
-        timeout=900.0,
-        domain_id=int(os.environ["ROS_DOMAIN_ID"]),  # reserved for this test process
-        run_dir=tmp_path / "run",
-        stream=out,
-    )
-    report = out.getvalue()
-    assert code == 0, report
-    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    mission = MissionRun.run(tmp_path, "depot", PARAMS, timeout=900.0)
+    report = mission.report
+    assert mission.code == 0, report
+    summary = mission.summary()
     assert summary["reached"] == summary["waypoints"] == 6, report
     assert summary["collisions"] == 0, report
 
-    run = GroundTruthRecorder.load(tmp_path / "run" / "run.json")
+    run = mission.truth()
     errors = run.localisation_errors()
     assert errors.size > 100, "EasyNav's pose estimate was not seen on /tf"
     assert float(errors.max()) < 0.1, report

@@ -6,39 +6,22 @@ error below 0.2 m, and the picture written.
 
 from __future__ import annotations
 
-import io
 import json
 import math
-import os
 
 import pytest
 
-from easynav.playground.demo import run_demo
-from easynav.playground.sim import GroundTruthRecorder
+from easynav.playground.demo.mission_run import MissionRun
 
 pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(900)]
 
 
-def _domain_id() -> int:
-    # The domain this test process reserved (repository conftest): no other process uses it.
-    return int(os.environ["ROS_DOMAIN_ID"])
-
-
 def test_demo_drives_the_home_tour_without_collision(tmp_path):
-    out = io.StringIO()
-    code = run_demo(
-        world="home",
-        speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "1.0")),
-        output_png=tmp_path / "demo.png",
-        timeout=400.0,
-        domain_id=_domain_id(),
-        run_dir=tmp_path / "run",
-        stream=out,
-    )
-    report = out.getvalue()
-    assert code == 0, report
+    mission = MissionRun.run(tmp_path, "home", timeout=400.0)
+    report = mission.report
+    assert mission.code == 0, report
     assert "waypoints reached:    4 of 4" in report and "collisions:           0" in report
-    run = GroundTruthRecorder.load(tmp_path / "run" / "run.json")
+    run = mission.truth()
     errors = run.localisation_errors()
     assert errors.size > 100, "EasyNav's pose estimate was not seen on /tf"
     assert float(errors.max()) < 0.2, report

@@ -15,14 +15,11 @@ edge, and 0 of 3 waypoints.
 
 from __future__ import annotations
 
-import io
-import json
-import os
 from pathlib import Path
 
 import pytest
 
-from easynav.playground.demo import run_demo
+from easynav.playground.demo.mission_run import MissionRun
 from easynav.playground.sim import GroundTruthRecorder
 from easynav.playground.world_description import WorldDescription
 
@@ -45,19 +42,8 @@ def _needs_costmap_stack():
 
 
 def _run(tmp_path, params: Path, timeout: float = 600.0):
-    out = io.StringIO()
-    code = run_demo(
-        world="furnished_office",
-        params_file=params,
-        speed_up=float(os.environ.get("EASYNAV_DEMO_SPEED_UP", "1.0")),
-        output_png=tmp_path / "demo.png",
-        timeout=timeout,
-        domain_id=int(os.environ["ROS_DOMAIN_ID"]),
-        run_dir=tmp_path / "run",
-        stream=out,
-    )
-    truth = json.loads((tmp_path / "run" / "ground_truth.json").read_text())
-    return code, out.getvalue(), truth
+    mission = MissionRun.run(tmp_path, "furnished_office", params, timeout=timeout)
+    return mission.code, mission.report, mission.ground_truth()
 
 
 @pytest.mark.parametrize("stack", ["octomap", "bonxai"])
