@@ -59,8 +59,9 @@ class GroundTruthRecorder:
             return 0.0
         return float(np.hypot(*np.diff(pts, axis=0).T).sum())
 
-    def localisation_errors(self) -> np.ndarray:
-        """Position errors (m) of the estimates against the interpolated truth.
+    def localisation_errors(self, start: float = -math.inf, end: float = math.inf) -> np.ndarray:
+        """Position errors (m) of the estimates stamped in ``[start, end]`` against the
+        interpolated truth.
 
         Estimates outside the span of the true trajectory are not paired (no extrapolation).
         """
@@ -68,7 +69,7 @@ class GroundTruthRecorder:
             return np.zeros(0)
         truth = np.array(self.true_poses)
         est = np.array(self.estimated_poses)
-        inside = (est[:, 0] >= truth[0, 0]) & (est[:, 0] <= truth[-1, 0])
+        inside = (est[:, 0] >= max(truth[0, 0], start)) & (est[:, 0] <= min(truth[-1, 0], end))
         est = est[inside]
         tx = np.interp(est[:, 0], truth[:, 0], truth[:, 1])
         ty = np.interp(est[:, 0], truth[:, 0], truth[:, 2])
