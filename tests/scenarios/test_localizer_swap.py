@@ -97,11 +97,12 @@ def test_switching_amcl_to_fusion_mid_mission_continues_from_the_last_pose(tmp_p
     assert state == "NAVIGATION_FINISHED", (state, message)
     assert run.truth.distance_driven(swap_at, ended_at) > 3.0  # most of the mission on fusion
     assert run.truth.collisions == []
-    # Continuity: right after the switch the estimate is where AMCL left it. Had the fusion
-    # localizer started from its own origin, the error would be the start's distance from
-    # (0, 0), 6.5 m.
+    # Continuity: right after the switch the estimate is where AMCL left it: AMCL's own error
+    # (below 0.2 m in the home world, as the demo checks) plus what the robot moved while
+    # EasyNav reconfigured, braking (< 0.1 m). Had the fusion localizer started from its own
+    # origin, the error would be the start's distance from (0, 0), 6.5 m.
     handed_over = run.truth.localisation_errors(swap_at, swap_at + 2.0)
-    assert handed_over.size > 5 and float(handed_over.max()) < 0.2, float(handed_over.max())
+    assert handed_over.size > 5 and float(handed_over.max()) < 0.3, float(handed_over.max())
     # Then wheels and IMU alone: dead reckoning drifts with the distance (the playground's wheels
     # slip; measured 0.1-0.3 m over the ~5 m after the switch, more on a loaded machine whose
     # late messages the filter integrates late). Bound: 0.5 m, still an order of magnitude below
