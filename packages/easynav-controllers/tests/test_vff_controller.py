@@ -108,6 +108,38 @@ def test_avoids_a_wall_next_to_the_path():
     assert_within_limits(run, LIMITS, DT, allow_reverse=False)
 
 
+def test_a_wall_behind_the_goal_does_not_hold_the_robot_short_of_it():
+    # A goal 0.2 m in front of a wall, as a waypoint by a kitchen counter: near the goal the
+    # attraction shrinks (distance_to_goal) while the wall's repulsion does not. Counting only
+    # the obstacles nearer than the goal, the robot reaches it (before, the two balanced 0.17 m
+    # short of it, outside the 0.15 m tolerance, and the robot stood there for ever).
+    clock = Clock()
+    params = {"distance_obstacle_detection": 0.7, "distance_to_goal": 0.5,
+              "obstacle_detection_x_min": 0.0, "follow_path": False}
+    vff = make_plugin(VffController, "vff", params, LIMITS, clock)
+    nav_state = NavState()
+    goal = PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(2.0, 0.0, 0.0))
+    nav_state.set("goals", Goals(Header(0.0, "map"), [goal]))
+    nav_state.set("goal_tolerance.position", 0.15)
+    nav_state.set("goal_tolerance.yaw", 0.15)
+    ys = np.arange(-1.0, 1.01, 0.05)
+    wall = np.column_stack((np.full_like(ys, 2.2), ys))
+
+    def scan(nav, pose):
+        x, y, yaw = pose
+        rel = wall - (x, y)
+        c, s = math.cos(yaw), math.sin(yaw)
+        local = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
+        nav.set("scan", PointPerception(np.column_stack((local, np.full(len(local), 0.3))),
+                                        "base_footprint", clock.t))
+
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
+    assert run.arrived, run.final
+    x, y, _ = run.final
+    assert math.hypot(x - 2.0, y) <= 0.15
+    assert_within_limits(run, LIMITS, DT, allow_reverse=False)
+
+
 def test_a_runtime_change_of_the_limits_takes_effect_at_once():
     clock = Clock()
     limits = Limits(LIMITS)
