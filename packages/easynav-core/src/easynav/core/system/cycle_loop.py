@@ -19,14 +19,13 @@ class CycleLoop(threading.Thread):
 
     Deadlines are absolute (``start + k·period``): the loop does not drift. A loop that falls
     more than one period behind restarts its schedule from now (no burst of catch-up cycles).
-    Between cycles it spins its executor until ``wait_guard`` (``WAIT_GUARD``, at most
-    a fifth of the period) before the next deadline, so ROS
-    callbacks are served as they arrive, then sleeps to the deadline (a sleep wakes up on time
-    more precisely than the executor's wait); after a cycle that overran, it still spins for at
-    most ``spin_time`` so callbacks are not starved. With ``wake`` (the RT loop), a callback
-    that brings new sensor data runs a triggered cycle at once, keeping perception-to-action
-    latency low (data arriving in the last ``WAIT_GUARD`` before a deadline is served right
-    after that deadline's cycle, and triggers a cycle then).
+    Between cycles it spins its executor until ``wait_guard`` (``WAIT_GUARD``, at most a fifth
+    of the period) before the next deadline, so ROS callbacks are served as they arrive, then
+    sleeps to the deadline (a sleep wakes up on time more precisely than the executor's wait);
+    after a cycle that overran, it still spins for at most ``spin_time`` so callbacks are not
+    starved. With ``wake`` (the RT loop), a callback that brings new sensor data runs a
+    triggered cycle at once, keeping perception-to-action latency low (data arriving in the last
+    ``wait_guard`` before a deadline is served right after that deadline's cycle).
 
     With ``realtime`` the thread asks for SCHED_FIFO ``priority`` (a warning, and normal priority,
     where it is not permitted). ``on_realtime_result(ok, message)`` reports the outcome.

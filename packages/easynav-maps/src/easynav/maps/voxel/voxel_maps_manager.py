@@ -335,10 +335,7 @@ class VoxelMapsManager(CostmapMapsManager):
         if not frame or frame.lstrip("/") == map_frame.lstrip("/"):
             return None  # no sensor position: the beams cannot be cast
         try:
-            try:
-                _, values = buffer.lookup_transform_values(map_frame, frame, perception.stamp)
-            except ExtrapolationError:
-                _, values = buffer.lookup_transform_values(map_frame, frame, None)
+            values = _transform_at(buffer, map_frame, frame, perception.stamp)
         except TransformError:
             self._throttle.warn(self.logger, f"tf-{frame}",
                                 f"{self.plugin_name}: no transform {map_frame} <- {frame}")
@@ -375,10 +372,7 @@ class VoxelMapsManager(CostmapMapsManager):
             map_frame = buffer.get_tf_info().map_frame
             origin = None
             if frame and frame.lstrip("/") != map_frame.lstrip("/"):
-                try:
-                    _, values = buffer.lookup_transform_values(map_frame, frame, stamp)
-                except ExtrapolationError:
-                    _, values = buffer.lookup_transform_values(map_frame, frame, None)
+                values = _transform_at(buffer, map_frame, frame, stamp)
                 points = transform_points(np.asarray(points, dtype=np.float64), values)
                 origin = np.array(values[:3], dtype=np.float64)
             self.replace_from_cloud(points, origin)
@@ -415,3 +409,12 @@ class VoxelMapsManager(CostmapMapsManager):
         publisher.publish(point_cloud2_from_points(self._voxels.occupied_centres(), frame, now))
         self._last_cloud = now
         self._cloud_dirty = False
+
+
+def _transform_at(buffer, target: str, source: str, stamp: float):
+    """``(x, y, z, qx, qy, qz, qw)`` of ``target <- source`` at ``stamp``, or the latest one when
+    ``stamp`` is outside the buffer. Raises TransformError without any."""
+    try:
+        return buffer.lookup_transform_values(target, source, stamp)[1]
+    except ExtrapolationError:
+        return buffer.lookup_transform_values(target, source, None)[1]
