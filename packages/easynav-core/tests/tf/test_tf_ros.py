@@ -106,3 +106,40 @@ def test_a_nan_transform_on_the_wire_is_rejected_by_the_listener(ros_local, capl
     assert ros_local.spin_until(lambda: buffer.frame_exists("base_link"))
     assert not buffer.frame_exists("laser")
     assert "'odom' -> 'laser'" in caplog.text
+
+
+def test_time_jumping_back_clears_the_buffer_so_the_new_run_is_used(ros_local):
+    """A simulator restarted under a running system: its clock goes back to zero. Without the
+    clear, the old run's transforms (stamped up to 60 s) would be the newest for the cache
+    window and every new one, stamped from 0 s, refused as too old."""
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+
+    listener_node = ros_local.create_node(
+        "sim_listener", parameter_overrides=[Parameter("use_sim_time", value=True)]
+    )
+    clock_node = ros_local.create_node("sim_clock")
+    clock_pub = clock_node.create_publisher(Clock, "/clock", 10)
+    buffer = TFBuffer()
+    listener = TFListener(listener_node, buffer)
+    dynamic = TFBroadcaster(clock_node)
+
+    def publish_clock(seconds: float) -> None:
+        msg = Clock()
+        msg.clock.sec = int(seconds)
+        clock_pub.publish(msg)
+
+    assert ros_local.spin_until(lambda: clock_pub.get_subscription_count() > 0)
+    assert ros_local.spin_until(lambda: clock_node.count_subscribers("tf") > 0)
+    publish_clock(60.0)
+    assert ros_local.spin_until(lambda: listener_node.get_clock().now().nanoseconds == 60e9)
+    dynamic.send_transform(_ts("odom", "base_link", 60.0, 5.0))
+    assert ros_local.spin_until(lambda: buffer.can_transform("odom", "base_link", 60.0))
+
+    publish_clock(1.0)  # the simulator restarted
+    assert ros_local.spin_until(lambda: listener_node.get_clock().now().nanoseconds == 1e9)
+    assert not buffer.frame_exists("base_link")
+    dynamic.send_transform(_ts("odom", "base_link", 1.0, 0.5))
+    assert ros_local.spin_until(lambda: buffer.can_transform("odom", "base_link", 1.0))
+    assert buffer.lookup_transform("odom", "base_link").transform.translation[0] == 0.5
+    listener.destroy()

@@ -100,6 +100,10 @@ class SystemNode(LifecycleNode):
         # (the safety channel's status, TF). rclpy serves a node from one executor only.
         self.rt_io_node = Node("_system_node_rt", namespace=namespace, **kwargs)
         self.system.rt_node = self.rt_io_node  # plugins' RT-side subscriptions (odometry)
+        # The buffer is shared by everything in this process under this namespace: transforms
+        # left by an earlier system (a runtime stopped and started again, the next test) are
+        # on another run's time line and would shadow this run's for the cache window.
+        get_tf_buffer(self._ns_key()).clear()
         self.tf_listener = TFListener(self.rt_io_node)
         self.safety = SafetySupervisor(self, self.rt_io_node)
         self.add_extension(self.safety)

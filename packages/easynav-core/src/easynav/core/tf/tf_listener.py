@@ -16,9 +16,16 @@ class TFListener:
     namespace each) fills its own tree. ``buffer`` None uses ``get_tf_buffer(<node namespace>)``.
     Callbacks run in whichever executor spins ``node`` (``callback_group`` chooses the group).
 
+    When the node's clock jumps back (a simulator or a bag restarted) or switches between
+    system and simulated time, the buffer is cleared, as tf2's buffer does: the transforms
+    stamped on the old time line would otherwise be taken for the newest for up to the cache
+    window, and every new one refused as too old.
+
     Thread contract: construct and ``destroy`` in the node's configuring thread; the callbacks
-    only call :meth:`TFBuffer.set_transform_values`, which is locked. A bad transform in a
-    message is rejected by the buffer with a warning; the rest of the message is still used.
+    only call :meth:`TFBuffer.set_transform_values`, which is locked; the clock's jump
+    callback (in whichever thread sets the clock) only calls :meth:`TFBuffer.clear`, locked
+    too. A bad transform in a message is rejected by the buffer with a warning; the rest of
+    the message is still used.
     """
 
     def __init__(
@@ -56,6 +63,26 @@ class TFListener:
                 callback_group=callback_group,
             ),
         ]
+        from rclpy.clock import JumpThreshold
+        from rclpy.duration import Duration
+
+        self._jump_handle = node.get_clock().create_jump_callback(
+            JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1)),
+            post_callback=self._on_time_jump,
+        )
+
+    def _on_time_jump(self, jump: Any) -> None:
+        from rclpy.clock import ClockChange
+
+        if jump.clock_change in (ClockChange.ROS_TIME_ACTIVATED, ClockChange.ROS_TIME_DEACTIVATED):
+            reason = "the time source changed"
+        elif jump.delta.nanoseconds < 0:
+            reason = f"time jumped back {-jump.delta.nanoseconds * 1e-9:.3f} s"
+        else:
+            return
+        if self.buffer.frames():
+            self._node.get_logger().warning(f"{reason}: clearing the TF buffer")
+        self.buffer.clear()
 
     def _on_tf(self, msg: Any) -> None:
         self._store(msg, "tf", False)
@@ -78,7 +105,10 @@ class TFListener:
             )
 
     def destroy(self) -> None:
-        """Destroy both subscriptions."""
+        """Destroy both subscriptions and the clock's jump callback."""
+        if self._jump_handle is not None:
+            self._jump_handle.unregister()
+            self._jump_handle = None
         for sub in self._subscriptions:
             self._node.destroy_subscription(sub)
         self._subscriptions = []
