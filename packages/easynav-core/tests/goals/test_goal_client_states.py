@@ -115,3 +115,25 @@ def test_a_reject_of_a_pause_does_not_end_a_pending_goal(scripted):
     assert client.get_state() is S.SENT_GOAL
     manager.answer(client, T.ACCEPT, "Goal accepted")
     assert bed.spin_until(lambda: client.get_state() is S.ACCEPTED_AND_NAVIGATING)
+
+
+def test_an_unanswered_request_is_repeated_unchanged_until_the_answer_comes(scripted):
+    """The goal manager's answer to a fresh client's first request can be lost (its publisher
+    not yet matched with the client's subscription): the client sends the same request again
+    every second, and a second ACCEPT for it changes nothing."""
+    bed, manager, client = scripted
+    client.send_goal(goal(1.0, 0.0))
+
+    def requests():
+        return [m for m in manager.wire.controls if m.user_id == client.id]
+
+    assert bed.spin_until(lambda: len(requests()) >= 3, timeout=5.0)
+    assert {(m.type, m.seq) for m in requests()} == {(T.REQUEST, requests()[0].seq)}
+    assert client.get_state() is S.SENT_GOAL
+    manager.answer(client, T.ACCEPT, "Goal accepted")
+    assert bed.spin_until(lambda: client.get_state() is S.ACCEPTED_AND_NAVIGATING)
+    sent = len(requests())
+    manager.answer(client, T.ACCEPT, "Goal accepted")  # the answer to a repeat
+    bed.spin_for(1.5)
+    assert client.get_state() is S.ACCEPTED_AND_NAVIGATING
+    assert len(requests()) == sent  # answered: no more repeats

@@ -243,3 +243,17 @@ def test_warnings_name_the_sender_and_work_with_a_ros_style_logger():
         "goal manager: unexpected ACCEPT message from 'confused_tool'",
         "abort_mission('nothing') ignored: no mission under way",
     ]
+
+
+def test_a_repeated_request_is_accepted_again_and_changes_nothing():
+    """A client repeats a request whose ACCEPT was lost (same user and seq): the same answer
+    again, even where a new request would be refused, and the mission is untouched."""
+    manager, nav_state, clock = accepted_manager(allow_preempt_goal=False)
+    goals_before = nav_state.get("goals", Goals)
+    clock.t += 1.0
+    replies = manager.handle_control(request("alice", goal(1.0, 0.0), seq=10))
+    assert [(r.type, r.seq, r.nav_current_user_id) for r in replies] == [(T.ACCEPT, 11, "alice")]
+    assert nav_state.get("goals", Goals) is goals_before
+    # A new request from the owner (a higher seq) is still a goal update, refused here.
+    replies = manager.handle_control(request("alice", goal(2.0, 0.0), seq=12))
+    assert [r.type for r in replies] == [T.REJECT]

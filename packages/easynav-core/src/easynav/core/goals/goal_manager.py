@@ -48,6 +48,9 @@ class GoalManager:
     REQUEST   active, ``allow_preempt_goal``         to a different old owner: CANCELLED
                                                      "Navigation preempted by others"; then ACCEPT
                                                      (the same owner re-sending = goal update)
+    REQUEST   active, the accepted request repeated  ACCEPT again, nothing else (addition: a
+              (same user, seq, stamp and goals)      client repeats a request whose answer was
+                                                     lost)
     REQUEST   active, preemption not allowed         REJECT "Goal rejected; unable to preempt
                                                      current active goal"
     CANCEL    not the owner (checked first)          REJECT "Trying to cancel a navigation not
@@ -119,6 +122,7 @@ class GoalManager:
         self._paused = False
         self._hold = False
         self._last_control = NavigationControl()
+        self._accepted_request: tuple | None = None  # _request_identity of the mission's
 
         self._start_time = 0.0
         self._paused_since: float | None = None
@@ -285,6 +289,10 @@ class GoalManager:
         if invalid is not None:
             return [self._reply(msg, T.REJECT, invalid)]
         out: list[NavigationControl] = []
+        if self._active and _request_identity(msg) == self._accepted_request:
+            # The owner repeating the request it made (our ACCEPT did not reach it): the same
+            # answer again, and the mission goes on untouched.
+            return [self._reply(msg, T.ACCEPT, p.GOAL_ACCEPTED)]
         if self._active:
             if not self._params.allow_preempt_goal:
                 return [self._reply(msg, T.REJECT, p.UNABLE_TO_PREEMPT)]
@@ -312,6 +320,7 @@ class GoalManager:
         self._warned_no_pose = False
         self._final_info_pending = True
         self._last_control = msg.copy()
+        self._accepted_request = _request_identity(msg)
         return reply
 
     def _on_cancel(self, msg: NavigationControl) -> list[NavigationControl]:
@@ -487,3 +496,12 @@ class GoalManager:
 
 
 _NOTHING = object()
+
+
+def _request_identity(msg: NavigationControl) -> tuple:
+    """What makes a REQUEST the same message sent again: sender, seq, stamp and the goals."""
+    return (
+        msg.user_id, msg.seq, msg.header.stamp,
+        tuple((g.header.frame_id, g.pose.x, g.pose.y, g.pose.z, g.pose.qx, g.pose.qy,
+               g.pose.qz, g.pose.qw) for g in msg.goals.goals),
+    )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Iterable
 from typing import Any
 
@@ -26,6 +27,9 @@ from easynav.core.goals.ros_conversion import (
 )
 from easynav.core.ros.converters import pose_stamped_from_msg
 from easynav.core.types import Goals, Header, PoseStamped
+
+#: Seconds without an answer after which a REQUEST is sent again (steady clock).
+REPEAT_PERIOD = 1.0
 
 
 class GoalManagerClient:
@@ -77,8 +81,14 @@ class GoalManagerClient:
     (the goal manager tells only the requester); a new accepted goal or the end of the
     navigation clears it.
 
-    Thread contract: the subscription callback runs in whatever executor spins ``node``; the
-    commands and getters may be called from any thread (one internal lock). Getters return
+    A REQUEST not answered within :data:`REPEAT_PERIOD` (1 s) is sent again, unchanged, until an
+    answer comes: a fresh client's first request can otherwise go unanswered for ever (the
+    goal manager's answer is lost while its publisher has not matched this client's
+    subscription yet). The goal manager answers a repeat (same ``user_id`` and ``seq`` as the
+    mission it follows) with the same ACCEPT and changes nothing; a second ACCEPT is ignored.
+
+    Thread contract: the subscription callback and the repeat timer run in whatever executor
+    spins ``node``; the commands and getters may be called from any thread (one internal lock). Getters return
     copies. Commands raise :class:`GoalClientError` when the state does not allow them and
     ``ValueError`` / ``TypeError`` for bad goals; they never block (spin the node to get the
     answers).
@@ -92,6 +102,7 @@ class GoalManagerClient:
         self._paused = False
         self._seq = 0
         self._request_seq: int | None = None
+        self._accepted_seq: int | None = None
         self._cancel_seqs: set[int] = set()
         self._feedback: NavigationControl | None = None
         self._result: NavigationControl | None = None
@@ -103,6 +114,15 @@ class GoalManagerClient:
         self._subscription = node.create_subscription(
             NavigationControlMsg, CONTROL_TOPIC, self._on_control, qos,
             callback_group=callback_group,
+        )
+        # A REQUEST not answered within REPEAT_PERIOD is sent again, unchanged (same seq): the
+        # answer can be lost when the goal manager's publisher has not yet matched this
+        # client's subscription (discovery runs separately in each direction; measured: 4 of 80
+        # first goals of a fresh client). The manager answers a repeat without acting on it.
+        self._pending_request: NavigationControlMsg | None = None
+        self._pending_since = 0.0
+        self._repeat_timer = node.create_timer(
+            REPEAT_PERIOD / 2, self._repeat_unanswered_request, callback_group=callback_group
         )
 
     # -- identity and discovery ------------------------------------------------------------
@@ -173,7 +193,20 @@ class GoalManagerClient:
             msg.goals = native
             self._request_seq = msg.seq
             self._state = next_state
-            self._publisher.publish(navigation_control_to_msg(msg))
+            self._pending_request = navigation_control_to_msg(msg)
+            self._pending_since = time.monotonic()
+            self._publisher.publish(self._pending_request)
+
+    def _repeat_unanswered_request(self) -> None:
+        with self._lock:
+            if self._pending_request is None or self._state not in (S.SENT_GOAL,
+                                                                    S.SENT_PREEMPT):
+                self._pending_request = None
+                return
+            if time.monotonic() - self._pending_since < REPEAT_PERIOD:
+                return
+            self._pending_since = time.monotonic()
+            self._publisher.publish(self._pending_request)
 
     def cancel(self) -> None:
         """Ask the goal manager to cancel this client's navigation (CANCEL); the answer
@@ -216,7 +249,8 @@ class GoalManagerClient:
             self._result = None
 
     def destroy(self) -> None:
-        """Remove this client's publisher and subscription from the node."""
+        """Remove this client's publisher, subscription and timer from the node."""
+        self._node.destroy_timer(self._repeat_timer)
         self._node.destroy_subscription(self._subscription)
         self._node.destroy_publisher(self._publisher)
 
@@ -275,6 +309,9 @@ class GoalManagerClient:
 
     def _handle(self, msg: NavigationControl) -> None:
         kind = msg.type
+        if kind == T.ACCEPT and self._state is S.ACCEPTED_AND_NAVIGATING and \
+                msg.seq == self._accepted_seq:
+            return  # the answer to a repeated REQUEST, the first one having arrived too
         replies_to_request = self._request_seq is not None and msg.seq == self._request_seq + 1
         if kind == T.PAUSED:
             self._paused = True
@@ -346,7 +383,9 @@ class GoalManagerClient:
 
     def _start_navigation(self) -> None:
         self._state = S.ACCEPTED_AND_NAVIGATING
+        self._accepted_seq = None if self._request_seq is None else self._request_seq + 1
         self._request_seq = None
+        self._pending_request = None
         self._paused = False
         self._feedback = None
         self._result = None
