@@ -88,10 +88,10 @@ class GoalManagerClient:
     mission it follows) with the same ACCEPT and changes nothing; a second ACCEPT is ignored.
 
     Thread contract: the subscription callback and the repeat timer run in whatever executor
-    spins ``node``; the commands and getters may be called from any thread (one internal lock). Getters return
-    copies. Commands raise :class:`GoalClientError` when the state does not allow them and
-    ``ValueError`` / ``TypeError`` for bad goals; they never block (spin the node to get the
-    answers).
+    spins ``node``; the commands and getters may be called from any thread (one internal
+    lock). Getters return copies. Commands raise :class:`GoalClientError` when the state does
+    not allow them and ``ValueError`` / ``TypeError`` for bad goals; they never block (spin the
+    node to get the answers).
     """
 
     def __init__(self, node: Any, callback_group: Any = None) -> None:
