@@ -188,3 +188,26 @@ def test_derived_params_point_the_voxel_maps_managers_at_the_world(tmp_path):
     system = yaml.safe_load(out.read_text())["system_node"]["ros__parameters"]
     assert system["robot_geometry"] == {"radius": 0.2, "height": 0.5}
     assert any("extrudes" in n for n in notes)
+
+
+def test_the_controller_cycle_is_read_from_easynavs_log(tmp_path):
+    from easynav.playground.demo.demo import controller_cycle_from_log
+
+    log = tmp_path / "easynav.log"
+    assert controller_cycle_from_log(log) is None  # no log
+    log.write_text(
+        "[INFO] [1.0] [planner_node]: cycle time of costmap (easynav_costmap_planner/"
+        "CostmapPlanner).update: 90 runs, median 12.000 ms, p99 30.000 ms, max 31.000 ms\n"
+        "[INFO] [1.0] [controller_node]: cycle time of rpp (easynav_regulated_pp_controller/"
+        "RegulatedPurePursuitController).update_rt: 2931 runs, median 0.310 ms, "
+        "p99 1.200 ms, max 3.400 ms\n"
+    )
+    cycle = controller_cycle_from_log(log)
+    assert cycle == {
+        "alias": "rpp", "plugin": "easynav_regulated_pp_controller/RegulatedPurePursuitController",
+        "runs": 2931, "median_ms": 0.31, "p99_ms": 1.2, "max_ms": 3.4,
+    }
+    summary = RunSummary.compute([], make_truth(), "NAVIGATION_FINISHED", "", 0.0, 10.0, 20.0)
+    summary.controller_cycle = cycle
+    assert "controller cycle:     median 0.31 ms, p99 1.20 ms, max 3.40 ms (rpp: " in (
+        summary.format_table())

@@ -29,3 +29,7 @@ def test_demo_drives_the_home_tour_without_collision(tmp_path):
     truth = json.loads((tmp_path / "run" / "ground_truth.json").read_text())
     assert truth["collisions"] == [] and truth["commands_received"] > 100
     assert not math.isnan(run.min_clearance)
+    # The controller's cost, from the line EasyNav logs when the demo stops it.
+    cycle = mission.summary()["controller_cycle"]
+    assert cycle["alias"] == "simple" and cycle["runs"] > 100, report
+    assert 0.0 < cycle["median_ms"] <= cycle["p99_ms"] <= cycle["max_ms"], report

@@ -21,6 +21,7 @@ from easynav.core.plugins.declarations import (
 from easynav.core.plugins.discovery import load_plugin_class
 from easynav.core.plugins.parameter_owner import ParameterOwner
 from easynav.core.plugins.plugin_kinds import PluginKind
+from easynav.core.system.cycle_times import CycleTimes
 from easynav.core.system.node_parameters import NodeParameters
 from easynav.core.system.system_context import SystemContext
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus
@@ -33,7 +34,8 @@ class ConfigurationError(RuntimeError):
 class LoadedPlugin:
     """A plugin instance with its alias and its rate monitors."""
 
-    __slots__ = ("alias", "name", "plugin", "rt_monitor", "monitor", "diag_name", "failing")
+    __slots__ = ("alias", "name", "plugin", "rt_monitor", "monitor", "diag_name", "failing",
+                 "times")
 
     def __init__(self, alias: str, name: str, plugin: MethodBase, diag_name: str) -> None:
         self.alias = alias
@@ -43,6 +45,8 @@ class LoadedPlugin:
         self.rt_monitor: RateMonitor | None = None
         self.monitor: RateMonitor | None = None
         self.failing: set[str] = set()  # methods whose last call raised
+        # How long update_rt / update take: logged at deactivation.
+        self.times = {"update_rt": CycleTimes(), "update": CycleTimes()}
 
 
 class ComponentNode(LifecycleNode):
@@ -125,6 +129,10 @@ class ComponentNode(LifecycleNode):
         self.active = False
         for lp in self.plugins:
             self._notify(lp, "on_deactivate")
+            for method, times in lp.times.items():
+                line = times.describe(lp.alias, lp.name, method)
+                if line is not None:
+                    self.get_logger().info(line)
         return super().on_deactivate(state)
 
     def _notify(self, lp: LoadedPlugin, hook: str) -> None:
@@ -377,7 +385,9 @@ class ComponentNode(LifecycleNode):
         the plugin that raised has run cleanly.
         """
         try:
+            start = time.perf_counter()
             result = getattr(lp.plugin, method)(self.nav_state)
+            lp.times[method].record(time.perf_counter() - start)
         except Exception as exc:
             now = time.monotonic()
             key = f"{lp.alias}.{method}"

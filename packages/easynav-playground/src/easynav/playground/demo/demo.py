@@ -387,6 +387,7 @@ def _run(
     )
     if monitor is not None:
         summary.late_rt_cycles = monitor.late_cycles
+    summary.controller_cycle = controller_cycle_from_log(Path(record).with_name("easynav.log"))
     truth.save(Path(record).with_name("run.json"))  # truth + EasyNav's estimates, for analysis
     Path(record).with_name("summary.json").write_text(json.dumps(summary.to_dict(), indent=2))
     print(summary.format_table(), file=out)
@@ -477,3 +478,26 @@ def main(argv: list[str] | None = None) -> int:
         domain_id=args.domain_id,
         run_dir=args.run_dir,
     )
+
+
+def controller_cycle_from_log(log_path: Path) -> dict | None:
+    """The controller's update_rt cost from the line EasyNav's controller_node logs when it
+    is deactivated (the last one, if it was activated more than once); None when absent."""
+    from easynav.core.system.cycle_times import DESCRIPTION_PATTERN
+
+    try:
+        text = log_path.read_text(errors="replace")
+    except OSError:
+        return None
+    found = None
+    for line in text.splitlines():
+        if "controller_node" not in line:
+            continue
+        match = DESCRIPTION_PATTERN.search(line)
+        if match and match["method"] == "update_rt":
+            found = {
+                "alias": match["alias"], "plugin": match["plugin"], "runs": int(match["runs"]),
+                "median_ms": float(match["median"]), "p99_ms": float(match["p99"]),
+                "max_ms": float(match["max"]),
+            }
+    return found

@@ -35,6 +35,9 @@ class RunSummary:
     command_rate: float = 0.0
     real_time_factor: float = math.nan
     late_rt_cycles: int | None = None
+    #: The controller's update_rt cost as EasyNav logged it when it stopped: ``{"alias",
+    #: "plugin", "runs", "median_ms", "p99_ms", "max_ms"}``; None when not found.
+    controller_cycle: dict | None = None
 
     @property
     def all_reached(self) -> bool:
@@ -112,6 +115,7 @@ class RunSummary:
             "command_rate": clean(self.command_rate),
             "real_time_factor": clean(self.real_time_factor),
             "late_rt_cycles": self.late_rt_cycles,
+            "controller_cycle": self.controller_cycle,
             "success": self.success,
         }
 
@@ -149,6 +153,12 @@ class RunSummary:
             lines.append(f"simulation speed:     x{self.real_time_factor:.2f} real time")
         if self.late_rt_cycles is not None:
             lines.append(f"late RT cycles:       {self.late_rt_cycles} (EasyNav's heartbeat)")
+        if self.controller_cycle is not None:
+            c = self.controller_cycle
+            lines.append(
+                f"controller cycle:     median {c['median_ms']:.2f} ms, p99 {c['p99_ms']:.2f} ms, "
+                f"max {c['max_ms']:.2f} ms ({c['alias']}: {c['plugin']}, {c['runs']} runs)"
+            )
         for c in self.collisions:
             lines.append(
                 f"  collision with {c.get('with')} at ({c.get('x', 0):.2f}, {c.get('y', 0):.2f}), "
