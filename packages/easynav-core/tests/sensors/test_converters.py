@@ -53,6 +53,7 @@ def test_scan_drops_nan_inf_and_out_of_range_and_counts_them():
     msg = make_scan(ranges, angle_min=0.0, angle_increment=0.1, range_min=0.1, range_max=10.0)
     points, stats = LaserScanConverter().convert(msg)
     assert (stats.not_finite, stats.out_of_range, stats.dropped) == (3, 2, 5)
+    assert (stats.infinite, stats.invalid) == (2, 3)  # ±inf are REP 117 values, not errors
     kept = np.array([0, 6, 7, 8])
     r = np.array([1.0, 2.0, 10.0, 0.1])
     np.testing.assert_allclose(points[:, 0], r * np.cos(0.1 * kept), atol=1e-6)
@@ -87,6 +88,15 @@ def test_laser_handler_warns_naming_the_sensor_and_makes_read_only_points(caplog
     assert len(perception) == 1 and not perception.points.flags.writeable
     assert "Sensor 'laser1'" in caplog.text and "dropped 2 of 3 ranges" in caplog.text
     assert handler.dropped_total == 2
+
+
+def test_laser_handler_drops_rep117_no_returns_without_a_warning(caplog):
+    """+inf (nothing within range) and -inf (too close) are what a conforming driver publishes
+    in an open space: dropped, counted, and no warning every 10 s."""
+    handler = LaserScanHandler()
+    perception = handler.to_perception(make_scan([1.0, math.inf, -math.inf, 2.0]), "laser1")
+    assert len(perception) == 2 and handler.dropped_total == 2
+    assert "dropped" not in caplog.text
 
 
 # -- PointCloud2 --------------------------------------------------------------------------------

@@ -18,11 +18,20 @@ class ScanConversionStats:
     beams: int
     not_finite: int
     out_of_range: int
+    #: Of ``not_finite``, the ±inf readings: REP 117's "no return" (+inf) and "too close"
+    #: (-inf), what a conforming driver publishes in an open space; the rest are NaN (errors).
+    infinite: int = 0
 
     @property
     def dropped(self) -> int:
         """Ranges that did not become points."""
         return self.not_finite + self.out_of_range
+
+    @property
+    def invalid(self) -> int:
+        """Dropped readings that are not REP 117 values: NaN and finite ranges outside
+        ``[range_min, range_max]`` (a driver or a cable problem worth a warning)."""
+        return self.not_finite - self.infinite + self.out_of_range
 
 
 class LaserScanConverter:
@@ -69,7 +78,8 @@ class LaserScanConverter:
         keep = finite & (ranges >= range_min) & (ranges <= range_max)
         kept = int(np.count_nonzero(keep))
         not_finite = n - int(np.count_nonzero(finite))
-        stats = ScanConversionStats(n, not_finite, n - kept - not_finite)
+        infinite = int(np.count_nonzero(np.isinf(ranges))) if not_finite else 0
+        stats = ScanConversionStats(n, not_finite, n - kept - not_finite, infinite)
         points = np.zeros((kept, 3), dtype=np.float64)
         if kept == n:
             r = ranges.astype(np.float64)

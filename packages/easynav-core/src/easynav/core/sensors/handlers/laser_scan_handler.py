@@ -13,9 +13,10 @@ from easynav.core.sensors.point_perception import PointPerception
 class LaserScanHandler(PerceptionHandler):
     """Scans become points in the scan frame (z = 0), vectorised.
 
-    Ranges that are NaN, ±inf or outside ``[range_min, range_max]`` are dropped; a warning
-    naming the sensor gives the counts (at most every 10 s). ``dropped_total`` and
-    ``beams_total`` count them since configuration.
+    Ranges that are NaN, ±inf or outside ``[range_min, range_max]`` are dropped. ±inf are
+    REP 117's "no return" / "too close", normal in an open space: dropped silently. NaN and
+    out-of-range readings get a warning naming the sensor with the counts (at most every
+    10 s). ``dropped_total`` and ``beams_total`` count them since configuration.
 
     Thread contract and exceptions: as :class:`PerceptionHandler`.
     """
@@ -32,12 +33,13 @@ class LaserScanHandler(PerceptionHandler):
     def to_perception(self, msg: Any, sensor_id: str) -> PointPerception:
         points, stats = self._converter.convert(msg)
         self.beams_total += stats.beams
-        if stats.dropped:
-            self.dropped_total += stats.dropped
+        self.dropped_total += stats.dropped
+        if stats.invalid:
             self.warn(
                 sensor_id,
-                f"dropped {stats.dropped} of {stats.beams} ranges ({stats.not_finite} NaN/inf, "
-                f"{stats.out_of_range} outside [{msg.range_min:g}, {msg.range_max:g}] m)",
+                f"dropped {stats.invalid} of {stats.beams} ranges "
+                f"({stats.not_finite - stats.infinite} NaN, {stats.out_of_range} outside "
+                f"[{msg.range_min:g}, {msg.range_max:g}] m)",
                 "ranges",
             )
         points.flags.writeable = False
