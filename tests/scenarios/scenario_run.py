@@ -139,8 +139,11 @@ class ScenarioRun:
         self.params_path = self.run_dir / "params.yaml"
         map_file = self.run_dir / "world.map"
         self.description.world.save_map_file(map_file)
+        robot = self.description.robot
         _notes, self.path_topic = derive_params(
-            source, map_file, self.description.start_pose, self.params_path
+            source, map_file, self.description.start_pose, self.params_path,
+            map_yaml=self.description.map_server_yaml(self.run_dir),
+            robot_radius=robot.radius if robot.declared else None, robot_height=robot.height,
         )
         self.record_path = self.run_dir / "ground_truth.json"
         env = dict(os.environ)
@@ -188,6 +191,7 @@ class ScenarioRun:
         self.monitor = None
         self.client = None
         self._hold_pub = None
+        self._teleport_pub = None
         self._safety_stop = threading.Event()
         self._safety_thread: threading.Thread | None = None
         self._safety_node = None
@@ -332,6 +336,19 @@ class ScenarioRun:
             durability=DurabilityPolicy.TRANSIENT_LOCAL,
         )
         self._hold_pub = self.monitor.create_publisher(Bool, "playground/hold", latched)
+        from geometry_msgs.msg import Pose2D
+
+        self._teleport_pub = self.monitor.create_publisher(Pose2D, "playground/teleport", 10)
+
+    def teleport_robot(self, x: float, y: float, yaw: float) -> None:
+        """Carry the robot to ``(x, y, yaw)`` (map frame) without odometry: a kidnap
+        (``playground/teleport``). Waits until the playground's subscription matched."""
+        from geometry_msgs.msg import Pose2D
+
+        self.spin_until(
+            lambda: self._teleport_pub.get_subscription_count() > 0, 20.0, "playground/teleport"
+        )
+        self._teleport_pub.publish(Pose2D(x=float(x), y=float(y), theta=float(yaw)))
 
     # ------------------------------------------------------------------ the safety channel
     def start_safety_channel(self, period: float = 0.05) -> None:

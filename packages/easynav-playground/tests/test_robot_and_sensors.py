@@ -237,3 +237,25 @@ def test_recorder_tracks_distance_clearance_and_localisation_error():
     for stamp, x, y, _ in rec.true_poses[::10]:
         rec.record_estimate(stamp, x + 0.1, y, 0.0)
     assert np.allclose(rec.localisation_errors(), 0.1)
+
+
+def test_a_teleported_robot_is_moved_without_odometry_and_not_into_a_wall():
+    """A kidnapped robot: the true pose jumps, the wheel odometry sees nothing of it."""
+    sim = make_sim(boxed_world())
+    sim.set_command(0.3, 0.0)
+    sim.run_for(1.0)
+    odom_before = (sim.odometry.x, sim.odometry.y, sim.odometry.yaw)
+    sim.teleport(-1.5, 1.0, math.pi / 2)
+    sim.step()
+    # Carried there stopped (the step then ramps it up again towards the command in force).
+    assert (sim.robot.x, sim.robot.y, sim.robot.yaw) == pytest.approx((-1.5, 1.0, math.pi / 2),
+                                                                      abs=1e-3)
+    assert sim.robot.v < 0.01
+    assert (sim.odometry.x, sim.odometry.y, sim.odometry.yaw) == pytest.approx(odom_before,
+                                                                               abs=1e-3)
+    sim.teleport(2.85, 0.0, 0.0)  # into the wall (inner face at 2.9, radius 0.2): refused
+    sim.step()
+    assert sim.robot.x < 0.0
+    assert [e[-1] for e in sim.teleport_events] == [True, False]
+    with pytest.raises(ValueError, match="not finite"):
+        sim.teleport(math.nan, 0.0, 0.0)

@@ -82,6 +82,15 @@ class WorldDescription:
             values["geodetic_origin"] = list(self.geodetic_origin)
         return values
 
+    def map_server_yaml(self, directory: Path) -> Path:
+        """The world's map as a map-server YAML (what the costmap and voxel maps managers
+        load): its own file when it is one (unknown cells stay unknown), else a conversion
+        written into ``directory``. Absolute."""
+        path = self.map_path
+        if path is None or path.suffix.lower() not in (".yaml", ".yml"):
+            path = self.world.save_map_server_yaml(Path(directory) / "world.yaml")
+        return path.resolve()
+
     def make_obstacles(self) -> list[MovingObstacle]:
         """Fresh :class:`MovingObstacle` objects (at their first waypoint); a
         :class:`ScriptedObstacle` for an entry with ``start_time``, ``start_distance``,

@@ -124,11 +124,6 @@ def run_demo(
         run_path.mkdir(parents=True, exist_ok=True)
         map_file = run_path / "world.map"
         description.world.save_map_file(map_file)
-        # Map-server maps go to the costmap maps manager as they are (unknown cells stay
-        # unknown); a .map world is converted.
-        map_yaml = description.map_path
-        if map_yaml is None or map_yaml.suffix.lower() not in (".yaml", ".yml"):
-            map_yaml = description.world.save_map_server_yaml(run_path / "world.yaml")
         robot = description.robot
         derived = run_path / "params.yaml"
         notes, path_topic = derive_params(
@@ -136,7 +131,7 @@ def run_demo(
             map_file,
             description.start_pose,
             derived,
-            map_yaml=map_yaml.resolve(),
+            map_yaml=description.map_server_yaml(run_path),
             robot_radius=robot.radius if robot.declared else None,
             robot_height=robot.height,
         )

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from geometry_msgs.msg import Twist, TwistStamped
+from geometry_msgs.msg import Pose2D, Twist, TwistStamped
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -121,8 +121,10 @@ class PlaygroundNode(Node):
     last collision) and the world on
     ``playground/world`` (latched OccupancyGrid). Subscribes ``cmd_vel`` (Twist),
     ``cmd_vel_stamped`` (TwistStamped) and ``playground/hold`` (std_msgs/Bool, transient local:
-    hold the robot in place, wheels blocked; the ``hold`` parameter is the initial state). It
-    publishes /clock; it does not use it.
+    hold the robot in place, wheels blocked; the ``hold`` parameter is the initial state) and
+    ``playground/teleport`` (geometry_msgs/Pose2D in the map frame: the robot is carried there,
+    stopped, with no odometry of the move: a kidnapped robot; a pose in collision is refused
+    with a warning). It publishes /clock; it does not use it.
 
     Thread contract: construct, :meth:`start` and :meth:`stop` from the main thread. Command
     callbacks run in the executor thread and only hand the command to the simulation (under
@@ -251,6 +253,7 @@ class PlaygroundNode(Node):
         )
         # Transient local, so that a latched hold published before this node started applies.
         self.create_subscription(Bool, "playground/hold", self._on_hold, _LATCHED)
+        self.create_subscription(Pose2D, "playground/teleport", self._on_teleport, _RELIABLE)
         self._warned_lateral = False
         self._rejected_commands = 0
 
@@ -365,6 +368,7 @@ class PlaygroundNode(Node):
         data["commands_rejected"] = self._rejected_commands
         data["start_pose"] = list(self.start_pose)
         data["holds"] = [list(event) for event in self.sim.hold_events]
+        data["teleports"] = [list(event) for event in self.sim.teleport_events]
         data["commands"] = [list(event) for event in self.sim.command_events]
         data["obstacles"] = [
             {"name": o.name, "started_at": getattr(o, "started_at", 0.0)}
@@ -464,6 +468,17 @@ class PlaygroundNode(Node):
                 f"robot {'held in place (wheels blocked)' if msg.data else 'released'} at "
                 f"t={self.sim.time:.2f} s"
             )
+
+    def _on_teleport(self, msg: Pose2D) -> None:
+        try:
+            self.sim.teleport(msg.x, msg.y, msg.theta)
+        except ValueError as exc:
+            self.get_logger().warning(f"playground/teleport refused: {exc}")
+            return
+        self.get_logger().warning(
+            f"teleport to ({msg.x:.2f}, {msg.y:.2f}, {msg.theta:.2f}) at t={self.sim.time:.2f} s "
+            "(no odometry of the move; refused at the next step if in collision)"
+        )
 
     def _on_cmd_vel(self, msg: Twist) -> None:
         self._command(msg)

@@ -46,6 +46,10 @@ class Simulation:
     both clocks (a process's view of simulated time lags on a loaded machine; the wall clock
     of one machine does not).
 
+    :meth:`teleport` carries the robot to another pose at the next step, stopped, without the
+    wheels turning (a kidnapped robot: the odometry sees nothing); a pose in collision is
+    refused. :attr:`teleport_events` lists ``(stamp, x, y, yaw, accepted)``.
+
     The laser is mounted at ``laser_offset`` ``(x, y, yaw)`` in the robot frame, at height
     ``laser_height``. Furniture ``boxes`` (:class:`BoxObstacle`) have heights: the laser sees
     those crossing its plane, the robot hits those reaching below ``robot_height`` (the world
@@ -54,8 +58,8 @@ class Simulation:
     points in the lidar frame at its rate.
 
     Thread contract: :meth:`step` and the callbacks run in one thread (the simulation loop);
-    :meth:`set_command` and :meth:`set_held` may be called from any thread (they only store
-    under a lock).
+    :meth:`set_command`, :meth:`set_held` and :meth:`teleport` may be called from any thread
+    (they only store under a lock).
 
     Raises:
         ValueError: a step or rate not finite and > 0, or a start pose in collision.
@@ -110,6 +114,8 @@ class Simulation:
         self._held = False
         self._was_held = False
         self.hold_events: list[tuple[float, bool]] = []
+        self._pending_teleport: tuple[float, float, float] | None = None
+        self.teleport_events: list[tuple[float, float, float, float, bool]] = []
         self.command_events: list[tuple[float, float, float]] = []
         self.commands_received = 0
         self._next_scan = scanner.period
@@ -141,6 +147,17 @@ class Simulation:
         """Hold the robot in place (True) or release it (False) from the next step on."""
         with self._command_lock:
             self._held = bool(held)
+
+    def teleport(self, x: float, y: float, yaw: float) -> None:
+        """Carry the robot to ``(x, y, yaw)`` at the next step (see the class documentation).
+
+        Raises:
+            ValueError: a value that is not finite.
+        """
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise ValueError(f"Simulation.teleport: pose ({x}, {y}, {yaw}) is not finite")
+        with self._command_lock:
+            self._pending_teleport = (float(x), float(y), float(yaw))
 
     @property
     def held(self) -> bool:
@@ -189,7 +206,15 @@ class Simulation:
         with self._command_lock:
             command, self._pending_command = self._pending_command, None
             held = self._held
+            teleport, self._pending_teleport = self._pending_teleport, None
         robot = self.robot
+        if teleport is not None:
+            tx, ty, tyaw = teleport
+            accepted = self.checker.colliding_with(tx, ty, self.obstacles) is None
+            if accepted:
+                robot.stop()
+                robot.apply_state(tx, ty, tyaw, 0.0, 0.0)
+            self.teleport_events.append((now, tx, ty, tyaw, accepted))
         if command is not None:
             robot.set_command(command[0], command[1], now)
             self.command_events.append((now, *robot.command, command[2]))
