@@ -9,6 +9,7 @@ from typing import Any
 
 from easynav_interfaces.msg import NavigationControl as NavigationControlMsg
 from geometry_msgs.msg import PoseStamped as PoseStampedMsg
+from rclpy.clock import Clock, ClockType
 
 from easynav.core.goals.goal_client_error import GoalClientError
 from easynav.core.goals.goal_client_state import GoalClientState as S
@@ -84,8 +85,9 @@ class GoalManagerClient:
     A REQUEST not answered within :data:`REPEAT_PERIOD` (1 s) is sent again, unchanged, until an
     answer comes: a fresh client's first request can otherwise go unanswered for ever (the
     goal manager's answer is lost while its publisher has not matched this client's
-    subscription yet). The goal manager answers a repeat (same ``user_id`` and ``seq`` as the
-    mission it follows) with the same ACCEPT and changes nothing; a second ACCEPT is ignored.
+    subscription yet). The goal manager answers a repeat (the same message: ``user_id``,
+    ``seq``, stamp and goals) with the same ACCEPT and changes nothing; a second ACCEPT for the
+    request is ignored.
 
     Thread contract: the subscription callback and the repeat timer run in whatever executor
     spins ``node``; the commands and getters may be called from any thread (one internal
@@ -121,8 +123,11 @@ class GoalManagerClient:
         # first goals of a fresh client). The manager answers a repeat without acting on it.
         self._pending_request: NavigationControlMsg | None = None
         self._pending_since = 0.0
+        # On the steady clock: a node on simulated time whose clock stands still (no /clock
+        # yet) must still repeat.
         self._repeat_timer = node.create_timer(
-            REPEAT_PERIOD / 2, self._repeat_unanswered_request, callback_group=callback_group
+            REPEAT_PERIOD / 2, self._repeat_unanswered_request, callback_group=callback_group,
+            clock=Clock(clock_type=ClockType.STEADY_TIME),
         )
 
     # -- identity and discovery ------------------------------------------------------------
