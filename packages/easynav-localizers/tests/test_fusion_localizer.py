@@ -265,3 +265,49 @@ def test_batch_transition_matches_the_reference():
     batch = transition_batch(states, 0.07)
     for row, moved in zip(states, batch, strict=False):
         np.testing.assert_allclose(moved, transition(row, 0.07), atol=1e-12)
+
+
+def test_map_to_odom_uses_the_odometry_transform_at_the_estimates_time():
+    """The filter's estimate is at the time of its last input; TF's odom -> robot may already
+    be newer (the inputs queue while the RT loop is late). map -> odom is estimate ∘ (odom ->
+    robot)⁻¹ at the estimate's time: with the newest transform it is off by what the robot
+    drove in between (here 1 m)."""
+    from easynav.core.tf import get_tf_buffer
+    from easynav.core.types import Transform, TransformStamped
+
+    params = {
+        "Ukf.global_filter.two_d_mode": True,
+        "Ukf.global_filter.publish_tf": True,
+        "Ukf.global_filter.initial_estimate_covariance": [1e-9] * 6 + [1.0] * 9,
+        "Ukf.global_filter.initial_state": [0.0] * 6 + [1.0] + [0.0] * 8,  # already driving
+        "Ukf.global_filter.odom0": "odom",
+        "Ukf.global_filter.odom0_config": [False] * 6 + [True, False, False,
+                                                         False, False, True] + [False] * 3,
+    }
+    namespace = f"fusion_tf_{next(_namespaces)}"
+    plugin = FusionLocalizer()
+    plugin.initialize(PluginContext(parameters=DictParameters(params), namespace=namespace),
+                      "Ukf")
+    buffer = get_tf_buffer(namespace)
+
+    def odom_tf(t: float) -> None:  # 1 m/s along x from the odom origin, there at t = 0.05
+        buffer.set_transform(TransformStamped(
+            Header(t, "odom"), "base_footprint",
+            Transform(np.array((t - 0.05, 0.0, 0.0)), np.array((0.0, 0.0, 0.0, 1.0)))), "test")
+
+    nav_state = NavState()
+    for k in range(1, 41):  # 2 s of odometry, at 1 m/s
+        t = k * 0.05
+        odom_tf(t)
+        plugin.add_odometry("global_filter", "odom0", Odometry(
+            header=Header(t, "odom"), twist=Twist(vx=1.0), twist_covariance=np.eye(6) * 1e-4))
+        plugin.update_rt(nav_state)
+    for k in range(41, 61):  # TF runs 1 s ahead of the odometry the filter has fused
+        odom_tf(k * 0.05)
+    plugin.update_rt(nav_state)
+    estimate = nav_state.get("robot_pose", Odometry)
+    assert estimate.header.stamp == pytest.approx(2.0)
+    _, (tx, ty, *_rest) = buffer.lookup_transform_values("map", "odom")
+    # The map and odom frames start together: map -> odom is the estimate's small error, not
+    # the 1 m driven after it.
+    assert abs(tx) < 0.1 and abs(ty) < 0.1, (tx, ty)

@@ -294,6 +294,17 @@ class TFBuffer:
                 acc = compose(inverse(up), acc)
         return stamp, acc
 
+    def lookup_transform_values_near(
+        self, target_frame: str, source_frame: str, time: float
+    ) -> tuple[float, TransformTuple]:
+        """:meth:`lookup_transform_values` at ``time``, or the latest when ``time`` is outside
+        the window (a stamp newer than the last transform received, or older than the cache).
+        Raises the other lookup errors (unknown frames, separate trees)."""
+        try:
+            return self.lookup_transform_values(target_frame, source_frame, time)
+        except ExtrapolationError:
+            return self.lookup_transform_values(target_frame, source_frame, None)
+
     def latest_common_time(self, target_frame: str, source_frame: str) -> float:
         """The newest time at which the whole chain is known (0.0 for a static chain)."""
         target = _strip(target_frame)

@@ -14,7 +14,7 @@ from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.sensors.point_perceptions_ops import transform_points
-from easynav.core.tf import ExtrapolationError, TransformError, get_tf_buffer
+from easynav.core.tf import TransformError, get_tf_buffer
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
 from easynav.maps.costmap.costmap_maps_manager import CostmapMapsManager
 from easynav.maps.costmap.keys import MAP, MAP_BASE, MAP_OBSTACLE_BOUNDS, MAP_TIME
@@ -335,7 +335,7 @@ class VoxelMapsManager(CostmapMapsManager):
         if not frame or frame.lstrip("/") == map_frame.lstrip("/"):
             return None  # no sensor position: the beams cannot be cast
         try:
-            values = _transform_at(buffer, map_frame, frame, perception.stamp)
+            values = buffer.lookup_transform_values_near(map_frame, frame, perception.stamp)[1]
         except TransformError:
             self._throttle.warn(self.logger, f"tf-{frame}",
                                 f"{self.plugin_name}: no transform {map_frame} <- {frame}")
@@ -372,7 +372,7 @@ class VoxelMapsManager(CostmapMapsManager):
             map_frame = buffer.get_tf_info().map_frame
             origin = None
             if frame and frame.lstrip("/") != map_frame.lstrip("/"):
-                values = _transform_at(buffer, map_frame, frame, stamp)
+                values = buffer.lookup_transform_values_near(map_frame, frame, stamp)[1]
                 points = transform_points(np.asarray(points, dtype=np.float64), values)
                 origin = np.array(values[:3], dtype=np.float64)
             self.replace_from_cloud(points, origin)
@@ -410,11 +410,3 @@ class VoxelMapsManager(CostmapMapsManager):
         self._last_cloud = now
         self._cloud_dirty = False
 
-
-def _transform_at(buffer, target: str, source: str, stamp: float):
-    """``(x, y, z, qx, qy, qz, qw)`` of ``target <- source`` at ``stamp``, or the latest one when
-    ``stamp`` is outside the buffer. Raises TransformError without any."""
-    try:
-        return buffer.lookup_transform_values(target, source, stamp)[1]
-    except ExtrapolationError:
-        return buffer.lookup_transform_values(target, source, None)[1]
