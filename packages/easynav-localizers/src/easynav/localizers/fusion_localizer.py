@@ -20,12 +20,7 @@ from easynav.core.types import (
     Header,
     Odometry,
     Pose,
-    Transform,
-    TransformStamped,
     Twist,
-    normalize_angle,
-    quaternion_to_yaw,
-    yaw_to_quaternion,
 )
 from easynav.localizers.fusion.fusion_filter import FusionFilter
 from easynav.localizers.fusion.fusion_parameters import (
@@ -36,6 +31,7 @@ from easynav.localizers.fusion.fusion_parameters import (
     read_inputs,
 )
 from easynav.localizers.fusion.ukf_filter import ROLL, YAW, UkfFilter, square_matrix
+from easynav.localizers.map_to_odom import map_to_odom
 
 #: NavState keys.
 ROBOT_POSE_LOCAL = NavStateKey(
@@ -340,25 +336,13 @@ class FusionLocalizer(LocalizerMethodBase):
 
     def _send_map_to_odom(self, state: np.ndarray, stamp: float) -> None:
         buffer = get_tf_buffer(self.context.namespace)
-        tf_info = buffer.get_tf_info()
         try:
-            # odom -> robot at the estimate's own time (robot_localization's way): the latest
-            # one, taken while the filter lags its inputs, put map -> odom off by the distance
-            # driven in between (0.5 m spikes at 0.7 m/s on a loaded machine).
-            _, (ox, oy, _, qx, qy, qz, qw) = buffer.lookup_transform_values_near(
-                tf_info.odom_frame, tf_info.robot_footprint_frame, stamp)
+            transform = map_to_odom(buffer, float(state[0]), float(state[1]),
+                                    float(state[YAW]), stamp)
         except Exception as exc:  # no odometry transform yet: nothing to anchor map → odom on
             self._throttle.warn(self.logger, "no-odom-tf",
                                 f"{self.plugin_name}: no map → odom: {exc}")
             return
-        oyaw = quaternion_to_yaw(qx, qy, qz, qw)
-        t_yaw = normalize_angle(float(state[YAW]) - oyaw)
-        c, s = math.cos(t_yaw), math.sin(t_yaw)
-        tx, ty = state[0] - (c * ox - s * oy), state[1] - (s * ox + c * oy)
-        transform = TransformStamped(
-            Header(stamp, tf_info.map_frame), tf_info.odom_frame,
-            Transform(np.array((tx, ty, 0.0)), np.array(yaw_to_quaternion(t_yaw))),
-        )
         if self._broadcaster is not None:
             self._broadcaster.send_transform(transform)
         else:

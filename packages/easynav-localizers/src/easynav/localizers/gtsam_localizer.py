@@ -21,13 +21,10 @@ from easynav.core.types import (
     Header,
     Odometry,
     Pose,
-    Transform,
-    TransformStamped,
-    normalize_angle,
     quaternion_to_yaw,
-    yaw_to_quaternion,
 )
 from easynav.localizers.fusion_localizer import GNSS_GROUP
+from easynav.localizers.map_to_odom import map_to_odom
 
 _STATIC = {"dynamic": False}
 
@@ -212,18 +209,10 @@ class GtsamLocalizer(LocalizerMethodBase):
 
     def _send_map_to_odom(self, pose, stamp: float) -> None:
         buffer = get_tf_buffer(self.context.namespace)
-        tf_info = buffer.get_tf_info()
         try:
-            _, (ox, oy, _, qx, qy, qz, qw) = buffer.lookup_transform_values(
-                tf_info.odom_frame, tf_info.robot_footprint_frame)
+            transform = map_to_odom(buffer, pose[0], pose[1], pose[2], stamp)
         except Exception:  # no odometry transform (yet): nothing to anchor map → odom on
             return
-        t_yaw = normalize_angle(pose[2] - quaternion_to_yaw(qx, qy, qz, qw))
-        c, s = math.cos(t_yaw), math.sin(t_yaw)
-        transform = TransformStamped(
-            Header(stamp, tf_info.map_frame), tf_info.odom_frame,
-            Transform(np.array((pose[0] - (c * ox - s * oy), pose[1] - (s * ox + c * oy), 0.0)),
-                      np.array(yaw_to_quaternion(t_yaw))))
         if self._broadcaster is not None:
             self._broadcaster.send_transform(transform)
         else:
