@@ -311,3 +311,42 @@ def test_map_to_odom_uses_the_odometry_transform_at_the_estimates_time():
     # The map and odom frames start together: map -> odom is the estimate's small error, not
     # the 1 m driven after it.
     assert abs(tx) < 0.1 and abs(ty) < 0.1, (tx, ty)
+
+
+def test_a_late_fix_does_not_pull_the_estimate_back():
+    """A fix that arrives after odometry has carried the estimate past its stamp (the sensors
+    node runs apart from the RT loop) is where the robot *was*: moved on by the estimated
+    motion since, it agrees with the estimate; fused as it is, it pulled the estimate back."""
+    sim = Sim(fusion_params(**{"Ukf.global_filter.gps0_rejection_threshold": 1e9}), seed=5)
+    projection = sim.projection
+    plugin, nav_state = sim.plugin, sim.nav_state
+    dt = 1.0 / RATE
+    t = 0.0
+    for k in range(int(20.0 * RATE)):  # straight along x at 1 m/s, exact sensors
+        t = (k + 1) * dt
+        plugin.add_odometry("global_filter", "odom0", Odometry(
+            header=Header(t, "odom"), pose=Pose.from_xy_yaw(t, 0.0, 0.0),
+            twist=Twist(vx=1.0), twist_covariance=np.eye(6) * 1e-4))
+        plugin.add_imu("global_filter", "imu0", ImuPerception(
+            orientation=np.array(yaw_to_quaternion(0.0)), orientation_covariance=np.eye(3) * 1e-4,
+            angular_velocity=np.zeros(3), angular_velocity_covariance=np.eye(3) * 1e-4,
+            linear_acceleration_covariance=-np.eye(3), stamp=t))
+        if k % GNSS_EVERY == 0:
+            lat, lon = projection.inverse(t, 0.0)
+            nav_state.set("gps", GNSSPerception(
+                latitude=lat, longitude=lon, altitude=ORIGIN[2],
+                position_covariance=np.eye(3) * 0.15**2,
+                position_covariance_type=COVARIANCE_TYPE_DIAGONAL_KNOWN,
+                status=STATUS_FIX, stamp=t))
+            nav_state.add_to_group("gnss", "gps")
+        plugin.update_rt(nav_state)
+    before = nav_state.get("robot_pose", Odometry).pose.x
+    assert before == pytest.approx(t, abs=0.1)
+    late = t - 0.8  # where the robot was 0.8 s ago, delivered now
+    lat, lon = projection.inverse(late, 0.0)
+    nav_state.set("gps", GNSSPerception(
+        latitude=lat, longitude=lon, altitude=ORIGIN[2], position_covariance=np.eye(3) * 0.15**2,
+        position_covariance_type=COVARIANCE_TYPE_DIAGONAL_KNOWN, status=STATUS_FIX, stamp=late))
+    plugin.update_rt(nav_state)
+    after = nav_state.get("robot_pose", Odometry).pose.x
+    assert after == pytest.approx(before, abs=0.05), (before, after)
