@@ -122,7 +122,7 @@ class GoalManager:
         self._paused = False
         self._hold = False
         self._last_control = NavigationControl()
-        self._accepted_request: tuple | None = None  # _request_identity of the mission's
+        self._accepted_request: tuple | None = None  # the mission's REQUEST (_request_identity)
 
         self._start_time = 0.0
         self._paused_since: float | None = None

@@ -14,6 +14,7 @@ from easynav.localizers.fusion.fusion_input import FusionInput
 from easynav.localizers.fusion.ukf_filter import (
     ROLL,
     VX,
+    VY,
     VYAW,
     YAW,
     UkfFilter,
@@ -196,7 +197,7 @@ class FusionFilter:
         state = self.ukf.state
         lag = self.time - stamp
         c, s = math.cos(state[YAW]), math.sin(state[YAW])
-        vx, vy = state[VX], state[VX + 1]
+        vx, vy = state[VX], state[VY]
         return np.array((c * vx - s * vy, s * vx + c * vy)) * lag
 
     def _begin(self, stamp: float) -> None:
