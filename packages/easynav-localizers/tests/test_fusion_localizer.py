@@ -313,6 +313,36 @@ def test_map_to_odom_uses_the_odometry_transform_at_the_estimates_time():
     assert abs(tx) < 0.1 and abs(ty) < 0.1, (tx, ty)
 
 
+def test_map_to_odom_when_the_odometry_transform_lags_the_estimate():
+    """The converse: the filter's inputs (their own subscriptions) have run 0.4 s ahead of the
+    ``odom -> robot`` transforms (the TF listener lags under load). The estimate is moved back
+    to the newest transform's stamp at its own velocity before the two are composed; composed
+    as they were, the robot stood 0.4 m ahead of itself on map -> odom -> robot."""
+    from easynav.core.tf import TFBuffer
+    from easynav.core.types import Transform, TransformStamped
+    from easynav.localizers.map_to_odom import map_to_odom
+
+    buffer = TFBuffer()
+    for k in range(0, 41):  # odom -> robot up to t = 2.0: 1 m/s along odom's x, turning
+        t = k * 0.05
+        yaw = 0.2 * t
+        buffer.set_transform(TransformStamped(
+            Header(t, "odom"), "base_footprint",
+            Transform(np.array((t, 0.0, 0.0)), np.array(yaw_to_quaternion(yaw)))), "test")
+    # The true robot at t = 2.4 in the map frame (map = odom shifted by (5, 3)), estimated
+    # exactly; its velocity in the body frame.
+    stamp = 2.4
+    true_then = (5.0 + 2.0, 3.0, 0.2 * 2.0)  # map pose at t = 2.0, where TF's latest is
+    estimate_x = true_then[0] + 0.4 * math.cos(0.44)  # moved on 0.4 s at 1 m/s, mid-yaw 0.44
+    estimate_y = true_then[1] + 0.4 * math.sin(0.44)
+    transform = map_to_odom(buffer, estimate_x, estimate_y, 0.2 * 2.4, stamp,
+                            twist=(1.0, 0.0, 0.2))
+    assert transform.header.stamp == stamp
+    np.testing.assert_allclose(transform.transform.translation[:2], (5.0, 3.0), atol=1e-3)
+    without = map_to_odom(buffer, estimate_x, estimate_y, 0.2 * 2.4, stamp)
+    assert math.hypot(*(without.transform.translation[:2] - (5.0, 3.0))) > 0.35
+
+
 def test_a_late_fix_does_not_pull_the_estimate_back():
     """A fix that arrives after odometry has carried the estimate past its stamp (the sensors
     node runs apart from the RT loop) is where the robot *was*: moved on by the estimated

@@ -30,7 +30,15 @@ from easynav.localizers.fusion.fusion_parameters import (
     prefixed,
     read_inputs,
 )
-from easynav.localizers.fusion.ukf_filter import ROLL, YAW, UkfFilter, square_matrix
+from easynav.localizers.fusion.ukf_filter import (
+    ROLL,
+    VX,
+    VY,
+    VYAW,
+    YAW,
+    UkfFilter,
+    square_matrix,
+)
 from easynav.localizers.map_to_odom import map_to_odom
 
 #: NavState keys.
@@ -338,7 +346,8 @@ class FusionLocalizer(LocalizerMethodBase):
         buffer = get_tf_buffer(self.context.namespace)
         try:
             transform = map_to_odom(buffer, float(state[0]), float(state[1]),
-                                    float(state[YAW]), stamp)
+                                    float(state[YAW]), stamp,
+                                    twist=(state[VX], state[VY], state[VYAW]))
         except Exception as exc:  # no odometry transform yet: nothing to anchor map → odom on
             self._throttle.warn(self.logger, "no-odom-tf",
                                 f"{self.plugin_name}: no map → odom: {exc}")

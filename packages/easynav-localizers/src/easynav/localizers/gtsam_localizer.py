@@ -94,6 +94,10 @@ class GtsamLocalizer(LocalizerMethodBase):
         self.estimator = None
         self._projection = None
         self._stamp = 0.0
+        # The pose is the last keyframe plus the odometry since: it is the robot at the last
+        # odometry message's stamp, moving at that message's twist (body frame).
+        self._odom_stamp: float | None = None
+        self._twist: tuple[float, float, float] | None = None
 
     def on_initialize(self) -> None:
         from easynav.core.plugins import PluginConfigurationError
@@ -114,6 +118,8 @@ class GtsamLocalizer(LocalizerMethodBase):
             self._queue.clear()
             self._offset = np.zeros(2)
             self._fix_stamp = None
+            self._odom_stamp = None
+            self._twist = None
         if self.context.node is not None:
             self._create_ros()
 
@@ -162,6 +168,10 @@ class GtsamLocalizer(LocalizerMethodBase):
                     if value.pose.is_finite():
                         p = value.pose
                         self.estimator.add_odometry(stamp, p.x, p.y, p.yaw)
+                        self._odom_stamp = stamp
+                        t = value.twist
+                        if all(math.isfinite(v) for v in (t.vx, t.vy, t.wz)):
+                            self._twist = (t.vx, t.vy, t.wz)
                 elif isinstance(value, ImuPerception):
                     if value.has_orientation and np.all(np.isfinite(value.orientation)):
                         sigma = self.params.imu_yaw_sigma or math.sqrt(
@@ -181,7 +191,8 @@ class GtsamLocalizer(LocalizerMethodBase):
             header=Header(self._stamp, tf_info.map_frame),
             child_frame_id=tf_info.robot_footprint_frame,
             pose=Pose.from_xy_yaw(*pose), pose_covariance=cov6))
-        self._send_map_to_odom(pose, self._stamp)
+        self._send_map_to_odom(pose, self._odom_stamp if self._odom_stamp is not None
+                               else self._stamp)
 
     def _new_fix(self, nav_state: NavState) -> GNSSPerception | None:
         if GNSS_GROUP not in nav_state.groups():
@@ -210,7 +221,7 @@ class GtsamLocalizer(LocalizerMethodBase):
     def _send_map_to_odom(self, pose, stamp: float) -> None:
         buffer = get_tf_buffer(self.context.namespace)
         try:
-            transform = map_to_odom(buffer, pose[0], pose[1], pose[2], stamp)
+            transform = map_to_odom(buffer, pose[0], pose[1], pose[2], stamp, twist=self._twist)
         except Exception:  # no odometry transform (yet): nothing to anchor map → odom on
             return
         if self._broadcaster is not None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -17,20 +18,31 @@ from easynav.core.types import (
 )
 
 
-def map_to_odom(buffer: TFBuffer, x: float, y: float, yaw: float,
-                stamp: float) -> TransformStamped:
+def map_to_odom(buffer: TFBuffer, x: float, y: float, yaw: float, stamp: float,
+                twist: Sequence[float] | None = None) -> TransformStamped:
     """``map → odom`` such that ``map → odom → robot`` is the planar estimate ``(x, y, yaw)``
-    at ``stamp``, with ``odom → robot`` looked up at ``stamp`` (the latest when ``stamp`` is
-    outside the buffer's window), as robot_localization does. With the latest transform
-    instead, an estimate that lags its inputs (queued odometry on a loaded machine) puts
-    ``map → odom`` off by the distance driven in between.
+    at ``stamp``, with ``odom → robot`` looked up at ``stamp``, as robot_localization does.
+    With the latest transform instead, an estimate that lags its inputs (queued odometry on a
+    loaded machine) puts ``map → odom`` off by the distance driven in between.
 
-    Frames from the buffer's TFInfo. Raises the buffer's lookup errors (TransformError) when
-    there is no ``odom → robot`` transform yet. Pure computation on the buffer; any thread.
+    When ``stamp`` is outside the buffer's window (typically newer than the last ``odom →
+    robot`` received: the transforms come through the TF listener, the estimator's inputs
+    through their own subscriptions, and either can lag under load) the latest transform is
+    used, and the estimate is first moved to that transform's stamp with ``twist`` — the
+    estimate's body-frame velocity ``(vx, vy, vyaw)``, held constant over the gap — so that
+    both sides of the composition describe the same instant. Without it (``None``) the
+    estimate is used as it is: a pose estimated 0.4 s after the transform at 0.7 m/s put the
+    robot 0.28 m ahead of itself until the next update.
+
+    The transform is stamped ``stamp``. Frames from the buffer's TFInfo. Raises the buffer's
+    lookup errors (TransformError) when there is no ``odom → robot`` transform yet. Pure
+    computation on the buffer; any thread.
     """
     tf_info = buffer.get_tf_info()
-    _, (ox, oy, _, qx, qy, qz, qw) = buffer.lookup_transform_values_near(
+    odom_stamp, (ox, oy, _, qx, qy, qz, qw) = buffer.lookup_transform_values_near(
         tf_info.odom_frame, tf_info.robot_footprint_frame, stamp)
+    if twist is not None and odom_stamp != 0.0 and odom_stamp != stamp:
+        x, y, yaw = _move(x, y, yaw, twist, odom_stamp - stamp)
     t_yaw = normalize_angle(yaw - quaternion_to_yaw(qx, qy, qz, qw))
     c, s = math.cos(t_yaw), math.sin(t_yaw)
     return TransformStamped(
@@ -38,3 +50,13 @@ def map_to_odom(buffer: TFBuffer, x: float, y: float, yaw: float,
         Transform(np.array((x - (c * ox - s * oy), y - (s * ox + c * oy), 0.0)),
                   np.array(yaw_to_quaternion(t_yaw))),
     )
+
+
+def _move(x: float, y: float, yaw: float, twist: Sequence[float],
+          dt: float) -> tuple[float, float, float]:
+    """The pose ``dt`` seconds later (earlier when negative) at constant body velocity
+    ``(vx, vy, vyaw)``: the rotation taken at the middle of the interval (second order)."""
+    vx, vy, vyaw = (float(v) for v in twist)
+    mid = yaw + 0.5 * vyaw * dt
+    c, s = math.cos(mid), math.sin(mid)
+    return x + (c * vx - s * vy) * dt, y + (s * vx + c * vy) * dt, yaw + vyaw * dt
