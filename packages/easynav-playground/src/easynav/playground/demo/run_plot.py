@@ -10,6 +10,7 @@ import numpy as np
 
 from easynav.playground.demo.waypoint_result import WaypointResult
 from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.terrain import Terrain
 from easynav.playground.sim.world import World
 
 
@@ -25,9 +26,12 @@ def plot_run(
     obstacles: Sequence[MovingObstacle] = (),
     title: str = "",
     progress_legend: bool = True,
+    terrain: Terrain | None = None,
 ) -> None:
     """Draw the world, moving-obstacle tracks, planned paths, the true and estimated
-    trajectories, the waypoints (green reached, red not) and collisions; save as PNG.
+    trajectories, the waypoints (green reached, red not) and collisions; save as PNG. A world's
+    ``terrain`` is drawn under them: heights in colour, contours every 0.2 m, and the ground
+    steeper than the robot climbs hatched.
 
     Any thread (matplotlib's object API with the Agg canvas, no global pyplot state).
     """
@@ -48,6 +52,8 @@ def plot_run(
         extent=(min_x, max_x, min_y, max_y),
         interpolation="nearest",
     )
+    if terrain is not None:
+        _draw_terrain(ax, terrain)
     for i, o in enumerate(obstacles):
         ax.plot(
             *o.waypoints.T,
@@ -113,6 +119,33 @@ def plot_run(
     fig.savefig(str(path), bbox_inches="tight")
 
 
+def _draw_terrain(ax, terrain: Terrain) -> None:
+    """Heights, contours and the too-steep ground of ``terrain`` on ``ax``."""
+    from easynav.maps.gridmap.grid_map import slope_layer
+
+    z = terrain.elevation
+    h, w = z.shape
+    r = terrain.resolution
+    extent = (terrain.origin_x, terrain.origin_x + w * r, terrain.origin_y,
+              terrain.origin_y + h * r)
+    ax.imshow(z, origin="lower", cmap="YlOrBr", alpha=0.55, extent=extent,
+              interpolation="nearest", vmin=0.0, vmax=max(float(z.max()), 1e-6) * 1.2)
+    xs = terrain.origin_x + (np.arange(w) + 0.5) * r
+    ys = terrain.origin_y + (np.arange(h) + 0.5) * r
+    top = float(z.max())
+    if top > float(z.min()):
+        levels = np.arange(math.floor(float(z.min()) / 0.2) * 0.2 + 0.2, top, 0.2)
+        if len(levels):
+            ax.contour(xs, ys, z, levels=levels, colors="saddlebrown", linewidths=0.4,
+                       alpha=0.7)
+    steep = (slope_layer(z, r) > terrain.max_climb_slope).astype(float)
+    if steep.any():
+        ax.contourf(xs, ys, steep, levels=[0.5, 1.5], colors="none", hatches=["////"])
+        ax.contour(xs, ys, steep, levels=[0.5], colors="firebrick", linewidths=0.6)
+        ax.plot([], [], color="firebrick", lw=0.6,
+                label=f"steeper than {terrain.max_climb_slope_deg:g} deg (cannot climb)")
+
+
 def plot_world(world_spec: str, path: str | Path) -> None:
     """Draw a world with its start pose, default waypoints and obstacle tracks (no run)."""
     from easynav.playground.world_description import WorldDescription, load_waypoints
@@ -134,4 +167,5 @@ def plot_world(world_spec: str, path: str | Path) -> None:
         obstacles=description.make_obstacles(),
         title=f"world '{description.world.name}': start, demo waypoints, moving obstacle tracks",
         progress_legend=False,
+        terrain=description.make_terrain(),
     )

@@ -38,6 +38,8 @@ class RunSummary:
     #: The controller's update_rt cost as EasyNav logged it when it stopped: ``{"alias",
     #: "plugin", "runs", "median_ms", "p99_ms", "max_ms"}``; None when not found.
     controller_cycle: dict | None = None
+    #: The steepest ground (rad) under the robot during the navigation; NaN on flat worlds.
+    max_slope: float = math.nan
 
     @property
     def all_reached(self) -> bool:
@@ -92,6 +94,7 @@ class RunSummary:
             localisation_samples=int(errors.size),
             command_rate=command_rate,
             real_time_factor=real_time_factor,
+            max_slope=truth.max_slope(nav_start, nav_end),
         )
 
     def to_dict(self) -> dict:
@@ -116,6 +119,7 @@ class RunSummary:
             "real_time_factor": clean(self.real_time_factor),
             "late_rt_cycles": self.late_rt_cycles,
             "controller_cycle": self.controller_cycle,
+            "max_slope_deg": clean(math.degrees(self.max_slope)),
             "success": self.success,
         }
 
@@ -149,6 +153,11 @@ class RunSummary:
             f"max {num(self.localisation_max, '.3f')} m ({self.localisation_samples} samples)",
             f"velocity commands:    {self.command_rate:.1f} Hz (simulated time)",
         ]
+        if not math.isnan(self.max_slope):
+            lines.append(
+                f"max slope driven:     {math.degrees(self.max_slope):.1f} deg (ground under the "
+                "robot)"
+            )
         if not math.isnan(self.real_time_factor):
             lines.append(f"simulation speed:     x{self.real_time_factor:.2f} real time")
         if self.late_rt_cycles is not None:

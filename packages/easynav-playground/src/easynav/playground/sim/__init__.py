@@ -14,6 +14,7 @@ from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.ray_casting import cast_rays_discs, cast_rays_grid
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.simulation import Simulation
+from easynav.playground.sim.terrain import Terrain
 from easynav.playground.sim.wheel_odometry import WheelOdometry
 from easynav.playground.sim.world import World
 
@@ -33,6 +34,7 @@ __all__ = [
     "MovingObstacle",
     "ScriptedObstacle",
     "Simulation",
+    "Terrain",
     "WheelOdometry",
     "World",
     "cast_rays_discs",

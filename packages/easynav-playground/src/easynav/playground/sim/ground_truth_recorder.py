@@ -13,7 +13,9 @@ class GroundTruthRecorder:
     """Keeps the true trajectory, an estimated one when given, clearances and collisions.
 
     Trajectories are lists of ``(stamp, x, y, yaw)``. The localisation error pairs each
-    estimate with the true pose interpolated at the estimate's stamp.
+    estimate with the true pose interpolated at the estimate's stamp. On a world with terrain,
+    :attr:`terrain` lists ``(stamp, z, slope)`` with each true pose: the ground height (m) and
+    slope (rad) under the robot (empty on flat worlds, and then absent from the saved file).
 
     Thread contract: not thread-safe. In the playground the simulation loop records; in the
     demo the executor thread records. Read results from the same thread or after the run.
@@ -24,6 +26,7 @@ class GroundTruthRecorder:
         self.estimated_poses: list[tuple[float, float, float, float]] = []
         self.clearances: list[tuple[float, float]] = []
         self.collisions: list[dict] = []
+        self.terrain: list[tuple[float, float, float]] = []
         self.min_clearance = math.inf
         self.min_clearance_at: tuple[float, float, float] | None = None
 
@@ -35,6 +38,16 @@ class GroundTruthRecorder:
                 f"{self.true_poses[-1][0]}"
             )
         self.true_poses.append((float(stamp), float(x), float(y), float(yaw)))
+
+    def record_terrain(self, stamp: float, z: float, slope: float) -> None:
+        """Add the ground height ``z`` (m) and slope (rad) under the robot at ``stamp``."""
+        self.terrain.append((float(stamp), float(z), float(slope)))
+
+    def max_slope(self, start: float = -math.inf, end: float = math.inf) -> float:
+        """The steepest slope (rad) under the robot between two stamps; NaN without terrain
+        samples there (a flat world)."""
+        slopes = [s for t, _, s in self.terrain if start <= t <= end]
+        return max(slopes) if slopes else math.nan
 
     def record_estimate(self, stamp: float, x: float, y: float, yaw: float) -> None:
         """Add an estimated pose sample (from a localizer), in the same frame as the truth."""
@@ -88,7 +101,7 @@ class GroundTruthRecorder:
     # ------------------------------------------------------------------ persistence
     def to_dict(self) -> dict:
         """A JSON-ready snapshot."""
-        return {
+        data = {
             "true_poses": self.true_poses,
             "estimated_poses": self.estimated_poses,
             "clearances": self.clearances,
@@ -96,6 +109,9 @@ class GroundTruthRecorder:
             "min_clearance": None if math.isinf(self.min_clearance) else self.min_clearance,
             "min_clearance_at": self.min_clearance_at,
         }
+        if self.terrain:
+            data["terrain"] = self.terrain
+        return data
 
     def save(self, path: str | Path) -> None:
         """Write :meth:`to_dict` as JSON (atomically: a reader never sees half a file)."""
@@ -121,6 +137,7 @@ class GroundTruthRecorder:
         rec.estimated_poses = [tuple(p) for p in data["estimated_poses"]]
         rec.clearances = [tuple(c) for c in data["clearances"]]
         rec.collisions = list(data["collisions"])
+        rec.terrain = [tuple(t) for t in data.get("terrain", ())]
         if data.get("min_clearance") is not None:
             rec.min_clearance = float(data["min_clearance"])
             at = data.get("min_clearance_at")

@@ -16,6 +16,7 @@ from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.sim.laser_scanner import LaserScanner
 from easynav.playground.sim.lidar_3d import Lidar3D
 from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.terrain import Terrain
 from easynav.playground.sim.wheel_odometry import WheelOdometry
 from easynav.playground.sim.world import World
 
@@ -57,6 +58,14 @@ class Simulation:
     ``lidar_offset`` ``(x, y, z, yaw)`` sees everything; ``on_cloud(stamp, points)`` gets its
     points in the lidar frame at its rate.
 
+    On a world with a ``terrain`` (:class:`Terrain`: ground heights) the wheels' motion is
+    laid on the ground (on a slope the horizontal advance shrinks by the cosine of the pitch),
+    and the robot cannot climb ground steeper than the terrain's ``max_climb_slope``: it stops
+    where it is, like at a wall, and a collision ``with`` ``"steep slope (S deg > LIMIT)"`` is
+    recorded once per stop (a new one after it moved :attr:`SLOPE_RELEASE` m). The recorder gets the
+    height and slope under the robot with every true pose (:meth:`GroundTruthRecorder.
+    record_terrain`). Without a terrain nothing of this applies (flat worlds).
+
     Thread contract: :meth:`step` and the callbacks run in one thread (the simulation loop);
     :meth:`set_command`, :meth:`set_held` and :meth:`teleport` may be called from any thread
     (they only store under a lock).
@@ -64,6 +73,9 @@ class Simulation:
     Raises:
         ValueError: a step or rate not finite and > 0, or a start pose in collision.
     """
+
+    #: m the robot must move from where a slope stopped it before another stop is recorded.
+    SLOPE_RELEASE = 0.05
 
     def __init__(
         self,
@@ -82,6 +94,7 @@ class Simulation:
         laser_height: float = 0.25,
         lidar: Lidar3D | None = None,
         lidar_offset: tuple[float, float, float, float] = (0.0, 0.0, 0.45, 0.0),
+        terrain: Terrain | None = None,
     ) -> None:
         for name, value in (("step", step), ("odom_rate", odom_rate)):
             if not (math.isfinite(value) and value > 0.0):
@@ -98,6 +111,8 @@ class Simulation:
         self.odometry = odometry
         self.obstacles = list(obstacles)
         self.checker = CollisionChecker(self.collision_world, robot_radius)
+        self.terrain = terrain
+        self._slope_stop_at: tuple[float, float] | None = None
         self.step_size = float(step)
         self.odom_period = 1.0 / float(odom_rate)
         self.laser_offset = tuple(float(v) for v in laser_offset)
@@ -223,17 +238,24 @@ class Simulation:
             self._was_held = held
             self.hold_events.append((now, held))
         x, y, yaw, v, w = robot.next_state(dt, now)
+        terrain = self.terrain
+        if terrain is not None and not held:
+            x, y = terrain.surface_step(robot.x, robot.y, x, y)
         what = None if held else self.checker.colliding_with(x, y, self.obstacles)
+        steep = None
+        if terrain is not None and not held and what is None:
+            steep = terrain.blocks(robot.x, robot.y, x, y)
         if held:
             # Wheels blocked: commanded, not moving, and the encoders count nothing.
             robot.stop()
             self.odometry.update(0.0, 0.0, dt)
-        elif what is None:
+        elif what is None and steep is None:
             dyaw = (yaw - robot.yaw + math.pi) % (2.0 * math.pi) - math.pi
             robot.apply_state(x, y, yaw, v, w)
             self.odometry.update(v * dt, dyaw, dt)
         else:
-            # Blocked (bumper): the base stops where it was; the wheels did not turn.
+            # Blocked (bumper, or a slope too steep to climb): the base stops where it was; the
+            # wheels did not turn.
             robot.stop()
             self.odometry.update(0.0, 0.0, dt)
         for obstacle in self.obstacles:
@@ -249,6 +271,8 @@ class Simulation:
         self.time = self.steps * dt
         stamp = self.time
         collision = self.checker.record(stamp, robot.x, robot.y, what, self.obstacles)
+        if terrain is not None:
+            collision = collision or self._slope_stop(stamp, steep)
         if collision is not None:
             self.recorder.record_collision(collision.as_dict())
             for cb in self.on_collision:
@@ -258,6 +282,10 @@ class Simulation:
         if stamp + eps >= self._next_odom:
             self._next_odom = _next_due(self._next_odom, self.odom_period, stamp)
             self.recorder.record_true(stamp, robot.x, robot.y, robot.yaw)
+            if terrain is not None:
+                self.recorder.record_terrain(
+                    stamp, terrain.height(robot.x, robot.y), terrain.slope(robot.x, robot.y)
+                )
             self.recorder.record_clearance(
                 stamp, robot.x, robot.y, self.checker.clearance(robot.x, robot.y, self.obstacles)
             )
@@ -277,6 +305,25 @@ class Simulation:
             points = self.cloud_now()
             for cb in self.on_cloud:
                 cb(stamp, points)
+
+    def _slope_stop(self, stamp: float, steep: float | None) -> Collision | None:
+        """The new slope stop at ``stamp`` (``steep``: the slope that stopped the robot this
+        step, None if it did not), once per stop; also counted in ``checker.collisions``."""
+        robot = self.robot
+        if self._slope_stop_at is not None:
+            sx, sy = self._slope_stop_at
+            if math.hypot(robot.x - sx, robot.y - sy) < self.SLOPE_RELEASE:
+                return None
+            self._slope_stop_at = None
+        if steep is None:
+            return None
+        self._slope_stop_at = (robot.x, robot.y)
+        limit = self.terrain.max_climb_slope_deg
+        collision = Collision(
+            stamp, robot.x, robot.y, f"steep slope ({math.degrees(steep):.1f} deg > {limit:g})"
+        )
+        self.checker.collisions.append(collision)
+        return collision
 
     def run_for(self, duration: float) -> None:
         """Step for ``duration`` simulated seconds (tests and offline runs)."""
