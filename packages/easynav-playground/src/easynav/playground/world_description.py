@@ -13,6 +13,7 @@ from easynav.playground.robot_description import RobotDescription
 from easynav.playground.sim.box_obstacle import BoxObstacle
 from easynav.playground.sim.moving_obstacle import MovingObstacle
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
+from easynav.playground.sim.terrain import Terrain
 from easynav.playground.sim.world import World
 
 WORLDS_DIR = Path(str(resources.files("easynav.playground") / "worlds"))
@@ -50,6 +51,9 @@ class WorldDescription:
                                                 # (gnss.* params; needs geodetic_origin)
         furniture:                     # optional: boxes with a height range (BoxObstacle)
           - {name: low shelf, box: [7.5, 3.0, 8.5, 3.4], z: [0.3, 0.4]}
+        terrain:                       # optional: ground heights (flat without the key)
+          elevation: maps/uneven_terrain.yaml  # a gridmap file (GridmapMapsManager's formats)
+          max_climb_slope_deg: 30.0    # the robot cannot climb steeper ground (Terrain)
 
     Thread contract: plain data; build it before starting threads.
     """
@@ -65,6 +69,15 @@ class WorldDescription:
     imu: dict | None = None
     gnss: dict | None = None
     furniture: list[BoxObstacle] = field(default_factory=list)
+    terrain_path: Path | None = None
+    max_climb_slope_deg: float = 30.0
+
+    def make_terrain(self) -> Terrain | None:
+        """The world's :class:`Terrain` (heights from :attr:`terrain_path`, the climb limit),
+        None for a flat world."""
+        if self.terrain_path is None:
+            return None
+        return Terrain.load(self.terrain_path, self.max_climb_slope_deg)
 
     def sensor_parameter_defaults(self) -> dict[str, object]:
         """Playground parameter defaults of this world's IMU and GNSS (``imu.enabled``,
@@ -179,7 +192,7 @@ class WorldDescription:
             raise ValueError(f"{path}: a world description needs a 'map' key")
         unknown = set(data) - {
             "map", "start_pose", "waypoints", "moving_obstacles", "robot", "furniture",
-            "geodetic_origin", "imu", "gnss",
+            "geodetic_origin", "imu", "gnss", "terrain",
         }
         if unknown:
             raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
@@ -224,6 +237,20 @@ class WorldDescription:
             BoxObstacle.from_dict(spec, f"{path}: furniture[{i}]")
             for i, spec in enumerate(furniture)
         ]
+        terrain = data.get("terrain")
+        terrain_path, climb = None, 30.0
+        if terrain is not None:
+            if not (isinstance(terrain, dict) and "elevation" in terrain
+                    and set(terrain) <= {"elevation", "max_climb_slope_deg"}):
+                raise ValueError(f"{path}: terrain must be a mapping with 'elevation' (a gridmap "
+                                 f"file) and optionally 'max_climb_slope_deg', got {terrain!r}")
+            terrain_path = path.parent / str(terrain["elevation"])
+            if not terrain_path.is_file():
+                raise ValueError(f"{path}: terrain elevation file {terrain_path} not found")
+            climb = terrain.get("max_climb_slope_deg", 30.0)
+            if not (isinstance(climb, (int, float)) and 0.0 < climb < 90.0):
+                raise ValueError(f"{path}: terrain.max_climb_slope_deg must be in (0, 90) deg, "
+                                 f"got {climb!r}")
         return cls(
             world,
             map_path=map_path,
@@ -236,6 +263,8 @@ class WorldDescription:
             imu=sensors.get("imu"),
             gnss=sensors.get("gnss"),
             furniture=boxes,
+            terrain_path=terrain_path,
+            max_climb_slope_deg=float(climb),
         )
 
 

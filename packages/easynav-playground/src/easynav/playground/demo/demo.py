@@ -134,6 +134,9 @@ def run_demo(
             map_yaml=description.map_server_yaml(run_path),
             robot_radius=robot.radius if robot.declared else None,
             robot_height=robot.height,
+            terrain_file=(
+                description.terrain_path.resolve() if description.terrain_path else None
+            ),
         )
         costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
         scan_topics = laser_scan_topics(params_path)
@@ -400,6 +403,7 @@ def _run(
             title=f"EasyNav playground demo: {description.world.name}, "
             f"{sum(w.reached for w in results)}/{len(results)} waypoints, "
             f"{len(truth.collisions)} collision(s), {summary.final_state}",
+            terrain=description.make_terrain(),
         )
         print(f"picture: {Path(output_png).resolve()}", file=out)
     if code == EXIT_INTERRUPTED:

@@ -11,6 +11,8 @@ from easynav.core.cli.params_file import load_ros_yaml
 SIMPLE_MAPS_MANAGER = "easynav_simple_maps_manager/SimpleMapsManager"
 #: Maps managers that load a ROS map-server YAML through ``package`` / ``map_path_file``.
 MAP_SERVER_MAPS_MANAGERS = ("easynav_costmap_maps_manager/CostmapMapsManager",)
+#: Maps managers of elevation maps (a gridmap file through ``package`` / ``map_path_file``).
+GRIDMAP_MAPS_MANAGERS = ("easynav_gridmap_maps_manager/GridmapMapsManager",)
 #: Voxel maps managers that extrude a map-server YAML given as ``occmap_path_file``, and the
 #: parameter naming their own map file (emptied, so that the world's map is the one loaded).
 VOXEL_MAPS_MANAGERS = {
@@ -58,6 +60,7 @@ def derive_params(
     map_yaml: Path | None = None,
     robot_radius: float | None = None,
     robot_height: float | None = None,
+    terrain_file: Path | None = None,
 ) -> tuple[list[str], str | None]:
     """Write ``out_path``: the params file with the world's map and start pose, sim time on.
 
@@ -66,6 +69,8 @@ def derive_params(
       ``package`` emptied) when given;
     - every ``OctomapMapsManager`` / ``BonxaiMapsManager`` alias extrudes ``map_yaml``
       (``occmap_path_file``; its own map file and ``package`` emptied) when given;
+    - every ``GridmapMapsManager`` alias loads ``terrain_file`` (the world's elevation map;
+      ``package`` emptied) when given (a world with terrain);
     - every localizer alias with an ``initial_pose`` starts at ``start_pose``;
     - ``system_node.robot_geometry.radius`` is ``robot_radius`` and ``.height`` is
       ``robot_height`` when given (the world's robot);
@@ -113,6 +118,12 @@ def derive_params(
             _set(maps, f"{alias}.{VOXEL_MAPS_MANAGERS[plugin]}", "")
             _set(maps, f"{alias}.occmap_path_file", str(map_yaml))
             notes.append(f"maps_manager_node.{alias} extrudes the world's map {map_yaml}")
+        elif plugin in GRIDMAP_MAPS_MANAGERS and terrain_file is not None:
+            _set(maps, f"{alias}.package", "")
+            _set(maps, f"{alias}.map_path_file", str(terrain_file))
+            notes.append(
+                f"maps_manager_node.{alias} loads the world's elevation map {terrain_file}"
+            )
         elif plugin in MAP_SERVER_MAPS_MANAGERS and map_yaml is not None:
             _set(maps, f"{alias}.package", "")
             _set(maps, f"{alias}.map_path_file", str(map_yaml))

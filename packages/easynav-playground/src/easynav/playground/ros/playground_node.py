@@ -27,6 +27,7 @@ from easynav.playground.sim import (
     LaserScanner,
     Lidar3D,
     Simulation,
+    Terrain,
     WheelOdometry,
 )
 from easynav.playground.world_description import WorldDescription
@@ -102,6 +103,8 @@ DEFAULT_PARAMETERS: dict[str, object] = {
     "gnss.jump_probability": 0.0,
     "gnss.jump_distance": 30.0,
     "gnss.outages": [0.0, 0.0],
+    # Worlds with terrain (heights): the steepest ground the robot climbs (the world's value).
+    "terrain.max_climb_slope_deg": 30.0,
 }
 
 _RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
@@ -116,9 +119,9 @@ class PlaygroundNode(Node):
     Publishes ``/clock`` (every step), ``scan`` (``laser.rate``), ``points`` (the 3D lidar's
     PointCloud2 in ``lidar_frame``, ``lidar.rate``, with ``lidar.enabled``), ``odom`` and the
     ``odom -> base_footprint`` transform on ``tf`` (``odom_rate``), ``ground_truth`` (true pose
-    in the map frame, same rate), the static ``base_footprint -> base_link -> base_laser`` (and
-    ``-> base_lidar``) transforms on ``tf_static``, ``collisions`` (latched JSON: count and the
-    last collision) and the world on
+    in the map frame, same rate; its z is the ground height on a world with terrain), the
+    static ``base_footprint -> base_link -> base_laser`` (and ``-> base_lidar``) transforms on
+    ``tf_static``, ``collisions`` (latched JSON: count and the last collision) and the world on
     ``playground/world`` (latched OccupancyGrid). Subscribes ``cmd_vel`` (Twist),
     ``cmd_vel_stamped`` (TwistStamped) and ``playground/hold`` (std_msgs/Bool, transient local:
     hold the robot in place, wheels blocked; the ``hold`` parameter is the initial state) and
@@ -147,6 +150,7 @@ class PlaygroundNode(Node):
             **DEFAULT_PARAMETERS,
             **self.description.robot.parameter_defaults(),
             **self.description.sensor_parameter_defaults(),
+            "terrain.max_climb_slope_deg": self.description.max_climb_slope_deg,
         }
         for name, default in defaults.items():
             if not self.has_parameter(name):
@@ -200,6 +204,11 @@ class PlaygroundNode(Node):
                 rng=rng_lidar,
             )
         self._lidar_offset = tuple(float(p(f"lidar.{k}")) for k in ("x", "y", "z", "yaw"))
+        self.terrain = None
+        if self.description.terrain_path is not None:
+            self.terrain = Terrain.load(
+                self.description.terrain_path, float(p("terrain.max_climb_slope_deg"))
+            )
         self.sim = Simulation(
             self.description.world,
             robot,
@@ -215,6 +224,7 @@ class PlaygroundNode(Node):
             laser_height=float(p("laser.z")),
             lidar=self.lidar,
             lidar_offset=self._lidar_offset,
+            terrain=self.terrain,
         )
         self.record_path = str(p("record"))
         self.frames = {
@@ -343,6 +353,8 @@ class PlaygroundNode(Node):
             f"world '{self.description.world.name}' ({self.description.source or 'built in'}), "
             f"start ({x:.2f}, {y:.2f}, {yaw:.2f}), step {self.sim.step_size * 1000:.1f} ms, "
             f"speed-up x{self.speed_up:g}, {len(self.sim.obstacles)} moving obstacle(s)"
+            + (f", terrain {self.description.terrain_path.name} (climbs up to "
+               f"{self.terrain.max_climb_slope_deg:g} deg)" if self.terrain is not None else "")
         )
         self._loop.start()
 
@@ -430,15 +442,16 @@ class PlaygroundNode(Node):
             )
         )
         robot = self.sim.robot
-        self._truth_pub.publish(
-            messages.planar_odometry_msg(
-                stamp,
-                f["map_frame"],
-                f["robot_footprint_frame"],
-                (robot.x, robot.y, robot.yaw),
-                (robot.v, robot.w),
-            )
+        truth = messages.planar_odometry_msg(
+            stamp,
+            f["map_frame"],
+            f["robot_footprint_frame"],
+            (robot.x, robot.y, robot.yaw),
+            (robot.v, robot.w),
         )
+        if self.terrain is not None:
+            truth.pose.pose.position.z = self.terrain.height(robot.x, robot.y)
+        self._truth_pub.publish(truth)
 
     def _publish_imu(self, stamp: float) -> None:
         robot = self.sim.robot
