@@ -16,10 +16,14 @@ from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Odometry, Pose, Transform, TransformStamped
 from easynav.localizers.costmap_amcl_localizer import CostmapAMCLLocalizer
 from easynav.localizers.costmap_sampling import (
+    RESET_FINE_SIGMA,
+    RESET_STRIDE,
     beam_likelihood_field,
     kld_particle_count,
     sample_free_space,
+    sensor_reset_poses,
 )
+from easynav.localizers.particle_filter import likelihood_field
 from easynav.maps import SimpleMap, resolve_map_file
 
 _namespaces = itertools.count()
@@ -160,6 +164,40 @@ def test_recovers_from_a_kidnapping(seed):
     sim.true[2] += 1.2
     errors = sim.drive(50.0)
     assert np.mean(errors[-100:]) < 0.1, errors[::100]
+
+
+@pytest.mark.parametrize("seed", [5, 6, 7])
+def test_a_robot_carried_to_another_room_is_found_by_sensor_resetting(seed):
+    """Carried 6 m into another room with 500 particles: uniform redraws put almost none
+    near it (the house's free space is ~80 m², so about 1 in 2000 lands within 0.25 m and
+    10°); sensor resetting redraws where the scan fits the map and the cloud finds the robot
+    within 10 s of driving."""
+    params = dict(BASE, sensor_model="likelihood_field", num_particles=500,
+                  recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
+                  **{"initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
+    sim = Sim(params, seed=seed)
+    sim.drive(4.0)
+    assert sim.error() < 0.1
+    sim.true[:] = (0.0, 5.8, 0.0)  # the north corridor, without odometry of the move
+    errors = sim.drive(10.0)
+    assert errors[0] > 4.0
+    assert np.mean(errors[-100:]) < 0.1, errors[::50]
+
+
+def test_sensor_reset_poses_put_the_true_pose_first():
+    costmap = house_costmap()
+    rng = np.random.default_rng(0)
+    field = likelihood_field(costmap, RESET_STRIDE)
+    for truth in [(8.0, 2.5, math.pi), (0.0, 5.8, 0.0), (6.0, 2.0, 1.0)]:
+        points = ray_cast(costmap, truth, 180, 6.0, rng)[:, :2]
+        poses = sensor_reset_poses(costmap, points, 200, rng, field,
+                                   likelihood_field(costmap, RESET_FINE_SIGMA))
+        assert poses.shape == (200, 3)
+        best = poses[0]
+        assert math.hypot(best[0] - truth[0], best[1] - truth[1]) < 0.15, (truth, best)
+        assert abs((best[2] - truth[2] + math.pi) % (2 * math.pi) - math.pi) < 0.1
+    with pytest.raises(ValueError, match="no scan points"):
+        sensor_reset_poses(costmap, np.zeros((0, 2)), 10, rng, field)
 
 
 def test_global_localisation_parameter_spreads_over_free_space():
