@@ -59,14 +59,6 @@ NOT_IN_CORPUS = {
 #: declares that this project does not accept yet (known incompatibilities, reported in issue
 #: #22). Remove an entry when the plugin learns the parameter.
 KNOWN_UNKNOWN_KEYS: dict[str, set[str]] = {
-    # The original's ukf_wrapper.cpp declares gpsN_differential / gpsN_relative (its own
-    # example_params.yaml sets gps0_differential) and imuN_twist_rejection_threshold (here only
-    # robot_localization's imuN_angular_velocity_rejection_threshold is accepted).
-    "outdoor_fusion.params.yaml": {
-        "localizer_node: Ukf.global_filter.gps0_differential",
-        "localizer_node: Ukf.global_filter.gps0_relative",
-        "localizer_node: Ukf.global_filter.imu0_twist_rejection_threshold",
-    },
     # The original easynav_diagnostic_recovery README lists debug_markers (false) for
     # CollisionSafetyReflex.
     "diagnostic_recovery.params.yaml": {

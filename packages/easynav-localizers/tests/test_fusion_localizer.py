@@ -236,13 +236,18 @@ def test_original_example_keys_are_known():
         "global_filter.two_d_mode": True, "global_filter.map_frame": "map",
         "global_filter.gps0": "/gps/fix", "global_filter.gps0_config": [True] * 15,
         "global_filter.gps0_differential": False,
+        "global_filter.gps0_relative": False,
+        "global_filter.imu0_twist_rejection_threshold": 5.0,
         "global_filter.imu0_remove_gravitational_acceleration": True,
         "global_filter.twist0_config": [False] * 15,
         "global_filter.process_noise_covariance": [0.0] * 225,
     }
     unknown = FusionLocalizer.unknown_parameter_keys(keys)
-    # gps0_differential is not a parameter of a GNSS input here (nor of the original's).
-    assert [k for k, _ in unknown] == ["global_filter.gps0_differential"]
+    # The original's ukf_wrapper.cpp declares gpsN_differential/_relative and
+    # imuN_twist_rejection_threshold; twistN has no _differential.
+    assert unknown == []
+    unknown = FusionLocalizer.unknown_parameter_keys({"global_filter.twist0_differential": True})
+    assert [k for k, _ in unknown] == ["global_filter.twist0_differential"]
 
 
 def test_ukf_transition_and_wrap():

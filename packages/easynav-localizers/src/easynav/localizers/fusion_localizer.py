@@ -177,7 +177,8 @@ class FusionLocalizer(LocalizerMethodBase):
         projection = None
         for prefix in prefixes:
             try:
-                inputs = read_inputs(self.context.parameters, f"{alias}.{prefix}")
+                inputs = read_inputs(self.context.parameters, f"{alias}.{prefix}",
+                                     warn=self.logger.error)
             except ParameterValueError as exc:
                 raise PluginConfigurationError(str(exc)) from None
             if prefix == "local_filter" and any(i.kind == "gps" for i in inputs):

@@ -39,6 +39,28 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
+def rpy_of_rotation(rotation: np.ndarray) -> np.ndarray:
+    """Fixed-axis roll, pitch, yaw of a rotation matrix (inverse of :func:`rotation_rpy`)."""
+    pitch = math.asin(max(-1.0, min(1.0, -rotation[2, 0])))
+    return np.array((math.atan2(rotation[2, 1], rotation[2, 2]), pitch,
+                     math.atan2(rotation[1, 0], rotation[0, 0])))
+
+
+def pose_in(reference: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """Pose ``(x, y, z, roll, pitch, yaw)`` expressed in the frame of pose ``reference``
+    (robot_localization's ``reference.inverseTimes(pose)``)."""
+    r = rotation_rpy(*reference[3:6])
+    out = np.empty(6)
+    out[:3] = r.T @ (pose[:3] - reference[:3])
+    out[3:6] = rpy_of_rotation(r.T @ rotation_rpy(*pose[3:6]))
+    return out
+
+
+def attitude_in(reference: np.ndarray, rpy: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw ``rpy`` relative to the attitude ``reference``."""
+    return rpy_of_rotation(rotation_rpy(*reference).T @ rotation_rpy(*rpy))
+
+
 class FusionFilter:
     """A :class:`UkfFilter` plus robot_localization's input handling.
 
@@ -51,6 +73,15 @@ class FusionFilter:
     (moved by :meth:`reset_pose`). With GNSS inputs the filter is uninitialised until the first
     fix, which sets x and y (and yaw from the last IMU orientation, if any); without them, the
     first measurement initialises it.
+
+    ``_relative`` inputs are taken relative to their first message (a pose in the frame of the
+    first pose; a fix minus the first fix, so the first fix is the origin). ``_differential``
+    inputs fuse the change between two consecutive messages divided by the time between them
+    as a robot-frame velocity (x, y, z → vx, vy, vz; roll, pitch, yaw → their rates), with the
+    variance of a difference, ``(C_prev + C)/dt²``, behind the input's pose gate: a pose's
+    change in the frame of the previous pose; an IMU's attitude change likewise; a fix's
+    change (a map-frame displacement) rotated into the robot frame by the estimated attitude.
+    A differential GNSS still initialises x and y from its first fix (as the original does).
 
     Counters ``accepted``/``rejected`` per input name are kept for diagnostics and tests.
 
@@ -74,7 +105,7 @@ class FusionFilter:
         self.accepted: dict[str, int] = {name: 0 for name in self.inputs}
         self.rejected: dict[str, int] = {name: 0 for name in self.inputs}
         self._last_imu_rpy: tuple[float, float, float] | None = None
-        self._previous_pose: dict[str, tuple[float, np.ndarray]] = {}
+        self._previous_pose: dict[str, tuple[float, np.ndarray, np.ndarray]] = {}
         self._first_pose: dict[str, np.ndarray] = {}
 
     # -- time ----------------------------------------------------------------------------------
@@ -117,14 +148,13 @@ class FusionFilter:
         rpy = np.array(quaternion_to_rpy(*q)) if imu.has_orientation else None
         if rpy is not None:
             self._last_imu_rpy = tuple(rpy)
+        attitude = self._imu_attitude(source, imu.stamp, rpy,
+                                      np.asarray(imu.orientation_covariance, dtype=float))
         self._begin(imu.stamp)
         if not self.initialized:
             return
-        idx = source.enabled(ROLL, YAW)
-        if idx and rpy is not None:
-            sel = [i - ROLL for i in idx]
-            cov = np.asarray(imu.orientation_covariance, dtype=float)
-            self._correct(source, idx, rpy[sel], cov[np.ix_(sel, sel)], source.pose_threshold)
+        if attitude is not None:
+            self._correct(source, *attitude, source.pose_threshold)
         idx = source.enabled(9, 11)
         if idx and imu.has_angular_velocity:
             sel = [i - 9 for i in idx]
@@ -143,19 +173,24 @@ class FusionFilter:
                           source.acceleration_threshold)
 
     def add_gnss(self, name: str, fix: GNSSPerception) -> bool:
-        """A ``gpsN`` fix; False when skipped (no fix) or rejected by the gate."""
+        """A ``gpsN`` fix; False when skipped (no fix, out of order, or the first of a
+        differential input once initialised) or rejected by the gate."""
         source = self.inputs[name]
         if not fix.has_fix or self.projection is None:
             return False
         east, north = self.projection.forward(fix.latitude, fix.longitude)
         position = np.array((east, north, fix.altitude - self.projection.altitude))
-        position[:2] += self.gnss_offset
         if fix.position_covariance_type >= COVARIANCE_TYPE_DIAGONAL_KNOWN:
             cov = np.asarray(fix.position_covariance, dtype=float).reshape(3, 3)
         else:
             cov = np.eye(3) * UNKNOWN_GNSS_VARIANCE
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(cov))):
             raise ValueError(f"{name}: non-finite fix")
+        if source.differential:
+            return self._add_gnss_step(source, fix.stamp, position, cov)
+        if source.relative:  # the first fix is the origin
+            position = position - self._first_pose.setdefault(name, position.copy())
+        position[:2] += self.gnss_offset
         if self.initialized and self.time is not None and fix.stamp < self.time:
             # A fix older than the estimate (it came through the sensors node while odometry
             # and IMU were already fused past it): where it was then, moved on by the motion
@@ -167,14 +202,7 @@ class FusionFilter:
         if not idx:
             return False
         if not self.initialized:
-            values, variances = list(position[idx]), list(np.diag(cov)[idx])
-            if self._last_imu_rpy is not None:
-                idx, values, variances = idx + [YAW], values + [self._last_imu_rpy[2]], \
-                    variances + [0.01]
-            self.ukf.set_variables(idx, values, variances)
-            self.initialized = True
-            self.accepted[name] += 1
-            return True
+            return self._initialise_from_fix(name, idx, position, cov)
         return self._correct(source, idx, position[idx], cov[np.ix_(idx, idx)],
                              source.pose_threshold)
 
@@ -191,6 +219,68 @@ class FusionFilter:
         self._previous_pose.clear()
 
     # -- internals -----------------------------------------------------------------------------
+    def _initialise_from_fix(self, name: str, idx: list[int], position: np.ndarray,
+                             cov: np.ndarray) -> bool:
+        values, variances = list(position[idx]), list(np.diag(cov)[idx])
+        if self._last_imu_rpy is not None:
+            idx, values, variances = idx + [YAW], values + [self._last_imu_rpy[2]], \
+                variances + [0.01]
+        self.ukf.set_variables(idx, values, variances)
+        self.initialized = True
+        self.accepted[name] += 1
+        return True
+
+    def _add_gnss_step(self, source: FusionInput, stamp: float, position: np.ndarray,
+                       cov: np.ndarray) -> bool:
+        """A differential ``gpsN``: the displacement since the previous fix, over the time
+        between them, rotated into the robot frame, fused as a velocity."""
+        name = source.name
+        previous = self._previous_pose.get(name)
+        if previous is not None and stamp <= previous[0]:
+            return False  # out of order
+        self._previous_pose[name] = (stamp, position, cov)
+        self._begin(stamp)
+        idx = source.enabled(0, Z)
+        if not idx:
+            return False
+        if not self.initialized:  # the first fix still places the robot (the original's)
+            absolute = position.copy()
+            absolute[:2] += self.gnss_offset
+            return self._initialise_from_fix(name, idx, absolute, cov)
+        if previous is None:
+            return False
+        dt = stamp - previous[0]
+        turn = rotation_rpy(*self.ukf.state[ROLL:YAW + 1]).T  # map → robot frame
+        velocity = turn @ (position - previous[1]) / dt
+        velocity_cov = turn @ (cov + previous[2]) @ turn.T / (dt * dt)
+        return self._correct(source, [i + VX for i in idx], velocity[idx],
+                             velocity_cov[np.ix_(idx, idx)], source.pose_threshold)
+
+    def _imu_attitude(self, source: FusionInput, stamp: float, rpy: np.ndarray | None,
+                      cov: np.ndarray) -> tuple[list[int], np.ndarray, np.ndarray] | None:
+        """The attitude part of an IMU reading as ``(state indices, values, covariance)``:
+        the angles (relative to the first reading with ``_relative``) or, with
+        ``_differential``, the change since the previous reading as body rates; None when
+        there is nothing to fuse."""
+        idx = source.enabled(ROLL, YAW)
+        if not idx or rpy is None:
+            return None
+        sel = [i - ROLL for i in idx]
+        if source.differential:
+            previous = self._previous_pose.get(source.name)
+            if previous is not None and stamp <= previous[0]:
+                return None
+            self._previous_pose[source.name] = (stamp, rpy, cov)
+            if previous is None:
+                return None
+            dt = stamp - previous[0]
+            rates = attitude_in(previous[1], rpy) / dt
+            rates_cov = (cov + previous[2]) / (dt * dt)
+            return ([i + VX for i in idx], rates[sel], rates_cov[np.ix_(sel, sel)])
+        if source.relative:
+            rpy = attitude_in(self._first_pose.setdefault(source.name, rpy.copy()), rpy)
+        return (idx, rpy[sel], cov[np.ix_(sel, sel)])
+
     def _displacement_since(self, stamp: float) -> np.ndarray:
         """Map-frame (x, y) moved from ``stamp`` to the estimate's time at the estimated
         velocity (constant over the lag)."""
@@ -208,35 +298,29 @@ class FusionFilter:
         idx = source.enabled(0, YAW)
         if not idx:
             return
-        cov = covariance.reshape(6, 6)
-        if source.relative:
-            first = self._first_pose.setdefault(source.name, pose.copy())
-            pose = self._relative(first, pose)
+        cov = np.asarray(covariance, dtype=float).reshape(6, 6)
         if source.differential:
             previous = self._previous_pose.get(source.name)
-            self._previous_pose[source.name] = (stamp, pose)
-            if previous is None or stamp <= previous[0]:
+            if previous is not None and stamp <= previous[0]:
+                return  # out of order: robot_localization drops it
+            self._previous_pose[source.name] = (stamp, pose, cov)
+            if previous is None:
                 return
             dt = stamp - previous[0]
-            delta = self._relative(previous[1], pose) / dt  # body-frame rates
-            vidx = [i + VX for i in idx]
-            sel = list(idx)
-            # Variance of a difference of two poses, per second.
-            self._correct(source, vidx, delta[sel], 2.0 * cov[np.ix_(sel, sel)] / (dt * dt),
-                          source.twist_threshold)
+            rates = pose_in(previous[1], pose) / dt  # robot-frame velocities
+            # Both covariances into the previous pose's frame (translation block).
+            turn = np.eye(6)
+            turn[:3, :3] = rotation_rpy(*previous[1][3:6]).T
+            rates_cov = turn @ (cov + previous[2]) @ turn.T / (dt * dt)
+            self._correct(source, [i + VX for i in idx], rates[idx],
+                          rates_cov[np.ix_(idx, idx)], source.pose_threshold)
             return
+        if source.relative:
+            first = self._first_pose.setdefault(source.name, pose.copy())
+            pose = pose_in(first, pose)
         if not self.initialized:
             return
         self._correct(source, idx, pose[idx], cov[np.ix_(idx, idx)], source.pose_threshold)
-
-    @staticmethod
-    def _relative(reference: np.ndarray, pose: np.ndarray) -> np.ndarray:
-        # Pose in the frame of ``reference``: translation rotated back, angles subtracted.
-        r = rotation_rpy(*reference[3:6])
-        out = np.empty(6)
-        out[:3] = r.T @ (pose[:3] - reference[:3])
-        out[3:6] = [_wrap(a - b) for a, b in zip(pose[3:6], reference[3:6], strict=False)]
-        return out
 
     def _correct(self, source: FusionInput, idx: list[int], values: np.ndarray,
                  cov: np.ndarray, threshold: float) -> bool:

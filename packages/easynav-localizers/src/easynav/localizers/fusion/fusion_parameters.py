@@ -7,7 +7,7 @@ import sys
 from typing import Any
 
 from easynav.core.plugins import Param
-from easynav.core.plugins.declarations import read_parameters
+from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.localizers.fusion.fusion_input import INPUT_KINDS, FusionInput
 from easynav.localizers.fusion.ukf_filter import (
     DEFAULT_INITIAL_COVARIANCE,
@@ -70,29 +70,36 @@ _THRESHOLD_DOC = "Mahalanobis gate (default: none)"
 
 
 def _input_suffixes(kind: str) -> tuple[Param, ...]:
+    # Which suffixes each kind has, as the original's ukf_wrapper.cpp declares them: odom, pose,
+    # imu and gps have _differential/_relative; twist has neither; imuN_angular_velocity_...
+    # is robot_localization's name of the original's imuN_twist_rejection_threshold.
     common = (
         Param("_config", [False] * 15, "which of the 15 state variables the input measures",
               **_STATIC),
         Param("_queue_size", 10, "messages kept between two cycles", ge=1, **_STATIC),
     )
     pose_like = (
-        Param("_differential", False, "differentiate poses into velocities", **_STATIC),
-        Param("_relative", False, "poses relative to the first message", **_STATIC),
+        Param("_differential", False, "fuse the change between consecutive poses as a "
+              "velocity (wins over _relative)", **_STATIC),
+        Param("_relative", False, "poses relative to the input's first message", **_STATIC),
     )
     if kind == "odom":
         return common + pose_like + (
             Param("_pose_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),
             Param("_twist_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),
         )
-    if kind == "pose":
+    if kind in ("pose", "gps"):
         return common + pose_like + (
             Param("_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),
         )
-    if kind in ("twist", "gps"):
+    if kind == "twist":
         return common + (Param("_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),)
     return common + pose_like + (  # imu
         Param("_pose_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),
-        Param("_angular_velocity_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),
+        Param("_twist_rejection_threshold", NO_THRESHOLD,
+              "angular velocity: " + _THRESHOLD_DOC, gt=0.0),
+        Param("_angular_velocity_rejection_threshold", NO_THRESHOLD,
+              "robot_localization's name of _twist_rejection_threshold", gt=0.0),
         Param("_linear_acceleration_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC,
               gt=0.0),
         Param("_remove_gravitational_acceleration", False, "subtract gravity from the "
@@ -122,9 +129,13 @@ def input_declarations(kind: str, index: int) -> tuple[Param, ...]:
     )
 
 
-def read_inputs(access: Any, prefix: str) -> list[FusionInput]:
+def read_inputs(access: Any, prefix: str, warn: Any = None) -> list[FusionInput]:
     """Inputs ``odom0, odom1, ..., gps0, ...`` set under ``prefix`` (numbered from 0 with no
-    gap, as robot_localization reads them). Raises ParameterValueError naming the key."""
+    gap, as robot_localization reads them). Raises ParameterValueError naming the key.
+
+    ``warn`` (a callable taking a message, optional) hears of an input with both
+    ``_differential`` and ``_relative`` true: differential is used, as in the original.
+    """
     inputs: list[FusionInput] = []
     for kind in INPUT_KINDS:
         n = 0
@@ -133,8 +144,6 @@ def read_inputs(access: Any, prefix: str) -> list[FusionInput]:
             name = f"{kind}{n}"
             config = values[name + "_config"]
             if len(config) != 15:
-                from easynav.core.plugins.declarations import ParameterValueError
-
                 raise ParameterValueError(
                     f"{prefix}.{name}_config: {len(config)} values, expected 15"
                 )
@@ -142,6 +151,11 @@ def read_inputs(access: Any, prefix: str) -> list[FusionInput]:
                                  queue_size=values[name + "_queue_size"])
             source.differential = values.get(name + "_differential", False)
             source.relative = values.get(name + "_relative", False)
+            if source.differential and source.relative:
+                if warn is not None:
+                    warn(f"{prefix}.{name}_differential and {prefix}.{name}_relative are both "
+                         "true: differential is used")
+                source.relative = False
             if kind in ("odom", "imu"):
                 source.pose_threshold = values[name + "_pose_rejection_threshold"]
             if kind == "odom":
@@ -151,7 +165,7 @@ def read_inputs(access: Any, prefix: str) -> list[FusionInput]:
             if kind == "twist":
                 source.twist_threshold = values[name + "_rejection_threshold"]
             if kind == "imu":
-                source.twist_threshold = values[name + "_angular_velocity_rejection_threshold"]
+                source.twist_threshold = _imu_twist_threshold(access, prefix, name, values)
                 source.acceleration_threshold = values[
                     name + "_linear_acceleration_rejection_threshold"]
                 source.remove_gravitational_acceleration = values[
@@ -159,6 +173,23 @@ def read_inputs(access: Any, prefix: str) -> list[FusionInput]:
             inputs.append(source)
             n += 1
     return inputs
+
+
+def _imu_twist_threshold(access: Any, prefix: str, name: str, values: Any) -> float:
+    """The angular-velocity gate of IMU ``name``: ``_twist_rejection_threshold`` (the
+    original's name) or ``_angular_velocity_rejection_threshold`` (robot_localization's); both
+    set to different values is an error naming both."""
+    original = f"{name}_twist_rejection_threshold"
+    upstream = f"{name}_angular_velocity_rejection_threshold"
+    set_original = access.is_set(f"{prefix}.{original}")
+    set_upstream = access.is_set(f"{prefix}.{upstream}")
+    if set_original and set_upstream and values[original] != values[upstream]:
+        raise ParameterValueError(
+            f"{prefix}.{original} = {values[original]} and {prefix}.{upstream} = "
+            f"{values[upstream]}: two names of the same gate, set to different values; "
+            "set one of them"
+        )
+    return values[upstream] if set_upstream and not set_original else values[original]
 
 
 def prefixed(prefix: str, declarations: tuple[Param, ...]) -> tuple[Param, ...]:
