@@ -57,14 +57,10 @@ NOT_IN_CORPUS = {
 
 #: Keys of corpus files that ``easynav check`` reports as unknown: parameters the original
 #: declares that this project does not accept yet (known incompatibilities, reported in issue
-#: #22). Remove an entry when the plugin learns the parameter.
-KNOWN_UNKNOWN_KEYS: dict[str, set[str]] = {
-    # The original easynav_diagnostic_recovery README lists debug_markers (false) for
-    # CollisionSafetyReflex.
-    "diagnostic_recovery.params.yaml": {
-        "recovery_node: recovery_manager.collision.debug_markers",
-    },
-}
+#: #22). Remove an entry when the plugin learns the parameter. Empty: the last ones (the fusion
+#: localizer's gps0_differential, gps0_relative, imu0_twist_rejection_threshold and
+#: CollisionSafetyReflex's debug_markers) are parameters now.
+KNOWN_UNKNOWN_KEYS: dict[str, set[str]] = {}
 
 _UNKNOWN = re.compile(
     r"^easynav: warning: .*?: (?P<node>[\w/]+): (?P<key>[\w.]+): unknown parameter"

@@ -163,3 +163,120 @@ def test_parameters_must_be_positive(name):
 
 def test_first_collision_on_an_empty_cloud():
     assert first_collision(np.empty((0, 3)), 0.5, 0.0, 0.0, 0.4, 0.5) is None
+
+
+# -- debug_markers ------------------------------------------------------------------------------
+class FakePublisher:
+    def __init__(self, msg_type, topic, qos):
+        self.msg_type, self.topic, self.qos = msg_type, topic, qos
+        self.published = []
+
+    def publish(self, msg):
+        self.published.append(msg)
+
+
+class FakeNode:
+    """The two calls the reflex makes on its node."""
+
+    def __init__(self):
+        self.publishers, self.destroyed = [], []
+
+    def create_publisher(self, msg_type, topic, qos):
+        self.publishers.append(FakePublisher(msg_type, topic, qos))
+        return self.publishers[-1]
+
+    def destroy_publisher(self, publisher):
+        self.destroyed.append(publisher)
+
+
+def test_debug_markers_keep_the_checked_box_and_the_points_in_it():
+    """Defaults: reach 0.3 + 0.1, brake_acc 0.5, height 0.5. At 0.5 m/s forward the box is
+    x in [-0.4, 0.4 + 0.25], y in [-0.4, 0.4], z in [z_min_filter, height]."""
+    reflex, nav_state, _ = make_reflex({"debug_markers": True, "z_min_filter": 0.05})
+    nav_state.set("laser1", scan([(0.6, 0.0, 0.2), (2.0, 0.0, 0.2), (0.1, -0.39, 0.3)]))
+    assert reflex.check_and_mitigate(nav_state, Twist(vx=0.5))
+    zone = reflex.last_zone
+    assert zone.frame == "base_footprint" and zone.imminent and zone.stamp == 1000.0
+    np.testing.assert_allclose(zone.lower, (-0.4, -0.4, 0.05))
+    np.testing.assert_allclose(zone.upper, (0.65, 0.4, 0.5))
+    np.testing.assert_allclose(zone.points, [(0.6, 0.0, 0.2), (0.1, -0.39, 0.3)])
+    # Backing up at 1 m/s with brake_acc 0.5: 1 m behind; the point ahead is outside now.
+    assert not reflex.check_and_mitigate(nav_state, Twist(vx=-1.0))
+    zone = reflex.last_zone
+    assert not zone.imminent
+    np.testing.assert_allclose(zone.lower[:2], (-1.4, -0.4))
+    np.testing.assert_allclose(zone.upper[:2], (0.4, 0.4))
+    np.testing.assert_allclose(zone.points, [(0.1, -0.39, 0.3)])
+
+
+def test_without_debug_markers_nothing_is_kept_or_published():
+    reflex, nav_state, _ = make_reflex()
+    assert reflex.params.debug_markers is False  # the original's default
+    nav_state.set("laser1", scan([(0.6, 0.0, 0.2)]))
+    assert reflex.check_and_mitigate(nav_state, Twist(vx=0.5))
+    assert reflex.last_zone is None
+
+
+def test_debug_markers_must_be_a_bool():
+    with pytest.raises(PluginConfigurationError, match=f"{ALIAS}.debug_markers"):
+        make_reflex({"debug_markers": "sometimes"})
+
+
+def test_markers_are_the_originals():
+    pytest.importorskip("visualization_msgs")
+    from visualization_msgs.msg import Marker
+
+    from easynav.recovery.diagnostic.reflexes.collision_safety_reflex import (
+        CollisionZone,
+        zone_markers,
+    )
+
+    zone = CollisionZone("base_footprint", 12.25, (-0.4, -0.4, 0.0), (0.65, 0.4, 0.5),
+                         np.array([(0.6, 0.0, 0.2), (np.nan, 0.0, 0.0)]), True)
+    delete, box, points = zone_markers(zone).markers
+    assert delete.action == Marker.DELETEALL
+    assert (box.type, box.action, box.id, box.ns) == (Marker.CUBE, Marker.ADD, 1,
+                                                      "collision_zone")
+    assert box.header.frame_id == "base_footprint"
+    assert (box.header.stamp.sec, box.header.stamp.nanosec) == (12, 250_000_000)
+    assert (box.pose.position.x, box.pose.position.y, box.pose.position.z) == \
+        pytest.approx((0.125, 0.0, 0.25))
+    assert (box.scale.x, box.scale.y, box.scale.z) == pytest.approx((1.05, 0.8, 0.5))
+    assert (box.color.r, box.color.g, box.color.a) == pytest.approx((1.0, 0.0, 0.25))
+    assert (box.lifetime.sec, box.lifetime.nanosec) == (0, 200_000_000)
+    assert points.type == Marker.SPHERE_LIST and points.scale.x == pytest.approx(0.03)
+    assert [(p.x, p.y, p.z) for p in points.points] == [pytest.approx((0.6, 0.0, 0.2))]
+    clear = CollisionZone("base_footprint", 0.0, (-0.4, -0.4, 0.0), (0.4, 0.4, 0.5),
+                          np.empty((0, 3)), False)
+    _, box, points = zone_markers(clear).markers
+    assert (box.color.r, box.color.g) == (0.0, 1.0) and points.points == []
+
+
+def test_markers_are_published_on_collision_area_when_asked():
+    pytest.importorskip("visualization_msgs")
+    import dataclasses
+
+    from visualization_msgs.msg import MarkerArray
+
+    for debug in (True, False):
+        nav_state = NavState()
+        actions = RecordingActions(nav_state)
+        node = FakeNode()
+        context = dataclasses.replace(
+            make_context({f"{ALIAS}.debug_markers": debug}, None, actions), node=node)
+        reflex = CollisionSafetyReflex()
+        reflex.initialize(context, ALIAS)
+        (publisher,) = node.publishers
+        assert (publisher.msg_type, publisher.topic, publisher.qos) == (MarkerArray,
+                                                                       "collision_area", 10)
+        nav_state.set("laser1", scan([(0.6, 0.0, 0.2)]))
+        reflex.check_and_mitigate(nav_state, Twist(vx=0.5))
+        reflex.check_and_mitigate(nav_state, Twist(wz=0.5))  # rotating in place: not looked
+        assert len(publisher.published) == (1 if debug else 0)
+        if debug:
+            assert isinstance(publisher.published[0], MarkerArray)
+        reflex.on_parameter_changed("debug_markers", not debug)  # a runtime change
+        reflex.check_and_mitigate(nav_state, Twist(vx=0.5))
+        assert len(publisher.published) == 1
+        reflex.on_cleanup()
+        assert node.destroyed == [publisher]

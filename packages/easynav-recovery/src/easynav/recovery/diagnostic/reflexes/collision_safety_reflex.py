@@ -5,11 +5,13 @@ the command about to be sent would hit an obstacle within its stopping distance.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import Param
+from easynav.core.plugins import Param, Topic
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Twist
 from easynav.recovery import nav_state_keys as keys
@@ -18,6 +20,24 @@ from easynav.recovery.fused_point_cloud import FusedPointCloud
 
 #: Below this linear speed (m/s) the robot is not moving (rotating in place is allowed blind).
 MOVING_SPEED = 1e-3
+#: Topic of the debug markers (relative: in the node's namespace, as the original's).
+MARKERS_TOPIC = "collision_area"
+#: Marker lifetime (s): a marker not renewed (the robot stopped) vanishes, as the original's.
+MARKER_LIFETIME = 0.2
+
+
+@dataclass(frozen=True)
+class CollisionZone:
+    """What one check looked at, in the robot footprint frame ``frame``: the box
+    ``lower``–``upper`` (x, y, z) around the robot disc stretched by the stopping distance,
+    the ``points`` (N, 3) inside it, and whether a collision was found (``imminent``)."""
+
+    frame: str
+    stamp: float
+    lower: tuple[float, float, float]
+    upper: tuple[float, float, float]
+    points: np.ndarray
+    imminent: bool
 
 
 class CollisionSafetyReflex(SafetyReflexBase):
@@ -41,7 +61,14 @@ class CollisionSafetyReflex(SafetyReflexBase):
     brakes too. Rotating in place (no linear speed) is never braked.
 
     Parameters: ``brake_acc`` (0.5 m/s², > 0), ``safety_margin`` (0.1 m), ``z_min_filter``
-    (0.0 m), ``downsample_leaf_size`` (0.1 m, > 0).
+    (0.0 m), ``downsample_leaf_size`` (0.1 m, > 0), ``debug_markers`` (false).
+
+    ``debug_markers`` (as the original's): every check that looks at the points (commanded to
+    move, a usable perception) publishes on ``collision_area`` (visualization_msgs/MarkerArray,
+    namespace-relative, depth 10) a DELETEALL, the checked box (CUBE) and the points inside it
+    (SPHERE_LIST, 3 cm), in the robot footprint frame, green, red when a collision is imminent,
+    alpha 0.25, lifetime 0.2 s. The last :class:`CollisionZone` is kept in :attr:`last_zone`
+    either way (None before the first look).
 
     Thread contract: as :class:`SafetyReflexBase` (``check`` in the RT thread).
     """
@@ -54,9 +81,22 @@ class CollisionSafetyReflex(SafetyReflexBase):
         Param("z_min_filter", 0.0, "points below this height are ignored", "m", dynamic=False),
         Param("downsample_leaf_size", 0.1, "voxel size of the fused cloud",
               "m", gt=0.0, dynamic=False),
+        Param("debug_markers", False, "publish the checked box and points on collision_area"),
+    )
+    TOPICS = (
+        Topic(MARKERS_TOPIC, "visualization_msgs/msg/MarkerArray", "pub", "reliable, depth 10",
+              "with debug_markers: the checked box and the points in it, red on a collision"),
     )
 
+    def __init__(self) -> None:
+        super().__init__()
+        self.last_zone: CollisionZone | None = None
+        self._marker_publisher: Any = None
+
     def on_initialize(self) -> None:
+        self._destroy_publisher()
+        self.debug_markers = self.params.debug_markers
+        self.last_zone = None
         self.brake_acc = self.params.brake_acc
         self.safety_margin = self.params.safety_margin
         self.z_min_filter = self.params.z_min_filter
@@ -71,6 +111,24 @@ class CollisionSafetyReflex(SafetyReflexBase):
             leaf_size=self.downsample_leaf_size,
             logger=self.logger,
         )
+        if self.context.node is not None:
+            try:
+                from visualization_msgs.msg import MarkerArray
+            except ImportError:
+                if self.debug_markers:
+                    self.logger.warning(f"{self.plugin_name}.debug_markers: visualization_msgs "
+                                        "is not installed: no markers")
+            else:
+                self._marker_publisher = self.context.node.create_publisher(
+                    MarkerArray, MARKERS_TOPIC, 10)
+
+    def on_cleanup(self) -> None:
+        self._destroy_publisher()
+
+    def _destroy_publisher(self) -> None:
+        publisher, self._marker_publisher = self._marker_publisher, None
+        if publisher is not None and self.context.node is not None:
+            self.context.node.destroy_publisher(publisher)
 
     def check(self, nav_state: NavState, commanded: Twist | None) -> bool:
         if commanded is None:
@@ -88,15 +146,88 @@ class CollisionSafetyReflex(SafetyReflexBase):
                 else f"no point perception can be transformed into '{frame}'"
             )
             return True
-        hit = first_collision(
-            points, vx, vy, wz, self.robot_radius + self.safety_margin, self.brake_acc
-        )
+        reach = self.robot_radius + self.safety_margin
+        hit = first_collision(points, vx, vy, wz, reach, self.brake_acc)
+        if self.debug_markers:
+            self._show(frame, points, vx, vy, reach, hit is not None)
         if hit is None:
             return False
         self.reason = (
             f"imminent collision with a point at ({hit[0]:.2f}, {hit[1]:.2f}) m at {speed:.2f} m/s"
         )
         return True
+
+
+    def _show(self, frame: str, points: np.ndarray, vx: float, vy: float, reach: float,
+              imminent: bool) -> None:
+        x_lo, x_hi, y_lo, y_hi = stopping_box(vx, vy, reach, self.brake_acc)
+        lower = (x_lo, y_lo, self.z_min_filter)
+        upper = (x_hi, y_hi, self.robot_height)
+        inside = points[in_box(points, lower, upper)] if points.shape[0] else points
+        stamp = self._cloud.stamp if math.isfinite(self._cloud.stamp) else self.now()
+        self.last_zone = CollisionZone(frame, stamp, lower, upper, inside, imminent)
+        if self._marker_publisher is not None:
+            self._marker_publisher.publish(zone_markers(self.last_zone))
+
+
+def stopping_box(vx: float, vy: float, reach: float,
+                 brake_acc: float) -> tuple[float, float, float, float]:
+    """``(x_min, x_max, y_min, y_max)`` of the broad phase: the box around the robot disc of
+    radius ``reach``, stretched by the stopping distance ``v²/(2·brake_acc)`` in the direction
+    of motion."""
+    speed = math.hypot(vx, vy)
+    stop_distance = speed * speed / (2.0 * brake_acc)
+    ext_x = stop_distance * vx / speed if speed > 0.0 else 0.0
+    ext_y = stop_distance * vy / speed if speed > 0.0 else 0.0
+    return (-reach + min(0.0, ext_x), reach + max(0.0, ext_x),
+            -reach + min(0.0, ext_y), reach + max(0.0, ext_y))
+
+
+def in_box(points: np.ndarray, lower, upper) -> np.ndarray:
+    """Mask of the ``points`` (N, 3) within ``lower``–``upper`` (bounds included)."""
+    return np.all((points >= np.asarray(lower)) & (points <= np.asarray(upper)), axis=1)
+
+
+def zone_markers(zone: CollisionZone) -> Any:
+    """The original's debug markers of ``zone``: a visualization_msgs/MarkerArray with a
+    DELETEALL, the box (CUBE, id 1) and the points (SPHERE_LIST, id 2), namespace
+    ``collision_zone``. Needs visualization_msgs (ImportError otherwise)."""
+    from geometry_msgs.msg import Point
+    from visualization_msgs.msg import Marker, MarkerArray
+
+    from easynav.core.ros.converters import time_to_msg
+
+    stamp = time_to_msg(zone.stamp)
+    colour = (1.0, 0.0, 0.0, 0.25) if zone.imminent else (0.0, 1.0, 0.0, 0.25)
+    lifetime_ns = int(MARKER_LIFETIME * 1e9)
+
+    def marker(marker_id: int, kind: int, action: int) -> Marker:
+        m = Marker()
+        m.header.frame_id = zone.frame
+        m.header.stamp = stamp
+        m.ns = "collision_zone"
+        m.id = marker_id
+        m.type = kind
+        m.action = action
+        m.pose.orientation.w = 1.0
+        return m
+
+    array = MarkerArray()
+    array.markers.append(marker(0, Marker.ARROW, Marker.DELETEALL))
+    box = marker(1, Marker.CUBE, Marker.ADD)
+    (x0, y0, z0), (x1, y1, z1) = zone.lower, zone.upper
+    box.pose.position.x, box.pose.position.y = (x0 + x1) / 2.0, (y0 + y1) / 2.0
+    box.pose.position.z = (z0 + z1) / 2.0
+    box.scale.x, box.scale.y, box.scale.z = x1 - x0, y1 - y0, max(z1 - z0, 0.0)
+    points = marker(2, Marker.SPHERE_LIST, Marker.ADD)
+    points.scale.x = points.scale.y = points.scale.z = 0.03
+    finite = zone.points[np.all(np.isfinite(zone.points), axis=1)]
+    points.points = [Point(x=float(x), y=float(y), z=float(z)) for x, y, z in finite]
+    for m in (box, points):
+        m.color.r, m.color.g, m.color.b, m.color.a = colour
+        m.lifetime.sec, m.lifetime.nanosec = divmod(lifetime_ns, 1_000_000_000)
+    array.markers.extend((box, points))
+    return array
 
 
 def first_collision(
@@ -111,16 +242,9 @@ def first_collision(
         return None
     speed = math.hypot(vx, vy)
     t_stop = speed / brake_acc
-    stop_distance = speed * speed / (2.0 * brake_acc)
-    ext_x = stop_distance * vx / speed if speed > 0.0 else 0.0
-    ext_y = stop_distance * vy / speed if speed > 0.0 else 0.0
+    x_lo, x_hi, y_lo, y_hi = stopping_box(vx, vy, reach, brake_acc)
     x, y = points[:, 0], points[:, 1]
-    box = (
-        (x >= -reach + min(0.0, ext_x))
-        & (x <= reach + max(0.0, ext_x))
-        & (y >= -reach + min(0.0, ext_y))
-        & (y <= reach + max(0.0, ext_y))
-    )
+    box = (x >= x_lo) & (x <= x_hi) & (y >= y_lo) & (y <= y_hi)
     if not np.any(box):
         return None
     px, py = x[box], y[box]
