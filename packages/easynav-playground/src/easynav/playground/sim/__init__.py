@@ -5,6 +5,7 @@ from easynav.playground.sim.box_obstacle import BoxObstacle, rasterize_boxes
 from easynav.playground.sim.collision import Collision
 from easynav.playground.sim.collision_checker import CollisionChecker
 from easynav.playground.sim.diff_drive_robot import DiffDriveRobot, integrate_unicycle
+from easynav.playground.sim.fleet import Fleet, PeerRobot
 from easynav.playground.sim.gnss_receiver import GnssFix, GnssReceiver
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.sim.imu_sensor import ImuReading, ImuSensor
@@ -24,6 +25,7 @@ __all__ = [
     "Collision",
     "CollisionChecker",
     "DiffDriveRobot",
+    "Fleet",
     "GnssFix",
     "GnssReceiver",
     "GroundTruthRecorder",
@@ -32,6 +34,7 @@ __all__ = [
     "LaserScanner",
     "Lidar3D",
     "MovingObstacle",
+    "PeerRobot",
     "ScriptedObstacle",
     "Simulation",
     "Terrain",

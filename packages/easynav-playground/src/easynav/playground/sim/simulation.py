@@ -110,6 +110,9 @@ class Simulation:
         self.lidar_offset = tuple(float(v) for v in lidar_offset)
         self.odometry = odometry
         self.obstacles = list(obstacles)
+        #: The other robots as discs (:class:`~easynav.playground.sim.fleet.PeerRobot`), set
+        #: by a :class:`~easynav.playground.sim.fleet.Fleet`; empty for a robot alone.
+        self.peers: list = []
         self.checker = CollisionChecker(self.collision_world, robot_radius)
         self.terrain = terrain
         self._slope_stop_at: tuple[float, float] | None = None
@@ -201,7 +204,7 @@ class Simulation:
 
     def scan_now(self) -> np.ndarray:
         """Take a scan from the current pose (no scheduling, no callbacks)."""
-        return self.scanner.scan(self.laser_world, *self.laser_pose(), self.obstacles)
+        return self.scanner.scan(self.laser_world, *self.laser_pose(), self._others())
 
     def cloud_now(self) -> np.ndarray:
         """Take a 3D lidar scan from the current pose (lidar frame; needs a lidar)."""
@@ -210,14 +213,29 @@ class Simulation:
         c, s = math.cos(r.yaw), math.sin(r.yaw)
         return self.lidar.scan(
             self.world, self.boxes, r.x + c * ox - s * oy, r.y + s * ox + c * oy, oz,
-            r.yaw + oyaw, self.obstacles,
+            r.yaw + oyaw, self._others(),
         )
 
     # ------------------------------------------------------------------ stepping
     def step(self) -> None:
         """Advance one fixed step (see the class documentation)."""
+        now = self.time
+        moved = self._move_robot()
+        move_obstacles(self.obstacles, [(self.robot, self.checker.robot_radius)], now,
+                       self.step_size)
+        self._finish_step(*moved)
+
+    def _others(self) -> list:
+        """What this robot sees and hits besides the walls: the moving obstacles, then the
+        other robots of a :class:`~easynav.playground.sim.fleet.Fleet` (discs)."""
+        return self.obstacles + self.peers if self.peers else self.obstacles
+
+    def _move_robot(self) -> tuple[str | None, float | None]:
+        """First part of a step: take the inputs and move the robot (not the obstacles);
+        returns what stopped it (or None) and the too-steep slope (or None)."""
         dt = self.step_size
         now = self.time
+        others = self._others()
         with self._command_lock:
             command, self._pending_command = self._pending_command, None
             held = self._held
@@ -225,7 +243,7 @@ class Simulation:
         robot = self.robot
         if teleport is not None:
             tx, ty, tyaw = teleport
-            accepted = self.checker.colliding_with(tx, ty, self.obstacles) is None
+            accepted = self.checker.colliding_with(tx, ty, others) is None
             if accepted:
                 robot.stop()
                 robot.apply_state(tx, ty, tyaw, 0.0, 0.0)
@@ -241,7 +259,7 @@ class Simulation:
         terrain = self.terrain
         if terrain is not None and not held:
             x, y = terrain.surface_step(robot.x, robot.y, x, y)
-        what = None if held else self.checker.colliding_with(x, y, self.obstacles)
+        what = None if held else self.checker.colliding_with(x, y, others)
         steep = None
         if terrain is not None and not held and what is None:
             steep = terrain.blocks(robot.x, robot.y, x, y)
@@ -258,19 +276,19 @@ class Simulation:
             # wheels did not turn.
             robot.stop()
             self.odometry.update(0.0, 0.0, dt)
-        for obstacle in self.obstacles:
-            obstacle.observe(now, robot.x, robot.y)
-            ox, oy = obstacle.position_after(dt)
-            gap = (
-                math.hypot(ox - robot.x, oy - robot.y) - obstacle.radius - self.checker.robot_radius
-            )
-            if gap >= 0.0:
-                obstacle.advance(dt)
+        return what, steep
 
+    def _finish_step(self, what: str | None, steep: float | None) -> None:
+        """Last part of a step (after every robot and obstacle moved): the clock, collisions,
+        the ground truth and the sensors that are due."""
+        dt = self.step_size
+        robot = self.robot
+        terrain = self.terrain
+        others = self._others()
         self.steps += 1
         self.time = self.steps * dt
         stamp = self.time
-        collision = self.checker.record(stamp, robot.x, robot.y, what, self.obstacles)
+        collision = self.checker.record(stamp, robot.x, robot.y, what, others)
         if terrain is not None:
             collision = collision or self._slope_stop(stamp, steep)
         if collision is not None:
@@ -287,7 +305,7 @@ class Simulation:
                     stamp, terrain.height(robot.x, robot.y), terrain.slope(robot.x, robot.y)
                 )
             self.recorder.record_clearance(
-                stamp, robot.x, robot.y, self.checker.clearance(robot.x, robot.y, self.obstacles)
+                stamp, robot.x, robot.y, self.checker.clearance(robot.x, robot.y, others)
             )
             for cb in self.on_odometry:
                 cb(stamp)
@@ -329,6 +347,26 @@ class Simulation:
         """Step for ``duration`` simulated seconds (tests and offline runs)."""
         for _ in range(int(round(duration / self.step_size))):
             self.step()
+
+
+def move_obstacles(
+    obstacles: Sequence[MovingObstacle],
+    robots: Sequence[tuple[DiffDriveRobot, float]],
+    now: float,
+    dt: float,
+) -> None:
+    """Walk each obstacle for ``dt`` unless that would make it touch one of the ``robots``
+    (``(robot, radius)`` pairs): it waits instead. Each obstacle first
+    :meth:`~MovingObstacle.observe` s the time and every robot (in order)."""
+    for obstacle in obstacles:
+        for robot, _radius in robots:
+            obstacle.observe(now, robot.x, robot.y)
+        ox, oy = obstacle.position_after(dt)
+        if all(
+            math.hypot(ox - robot.x, oy - robot.y) - obstacle.radius - radius >= 0.0
+            for robot, radius in robots
+        ):
+            obstacle.advance(dt)
 
 
 def _next_due(scheduled: float, period: float, now: float) -> float:
