@@ -171,3 +171,112 @@ def test_node_takes_the_worlds_robot_unless_a_parameter_overrides_it(ros_bed):
     assert node.get_parameter("laser.max_range").value == pytest.approx(3.5)
     assert node.get_parameter("base.max_linear_vel").value == pytest.approx(0.5)
     assert node.get_parameter("laser.beams").value == 90  # the explicit parameter wins
+
+
+def test_two_robots_have_their_own_topics_frames_and_record(ros_bed, tmp_path):
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from rclpy.qos import DurabilityPolicy, QoSProfile
+    from sensor_msgs.msg import LaserScan
+    from tf2_msgs.msg import TFMessage
+
+    from easynav.playground.ros.playground_node import PlaygroundNode
+
+    latched = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    received: dict[str, list] = {}
+    probe = Node("probe", context=ros_bed.context)
+    topics = [("/scan", LaserScan, 10), ("/odom", Odometry, 10), ("/tf", TFMessage, 10)]
+    for robot in ("r1", "r2"):
+        topics += [
+            (f"/{robot}/scan", LaserScan, 10),
+            (f"/{robot}/odom", Odometry, 10),
+            (f"/{robot}/ground_truth", Odometry, 10),
+            (f"/{robot}/tf", TFMessage, 10),
+            (f"/{robot}/tf_static", TFMessage, latched),
+        ]
+    for topic, kind, qos in topics:
+        received[topic] = []
+        probe.create_subscription(kind, topic, lambda m, t=topic: received[t].append(m), qos)
+    r1_cmd = probe.create_publisher(Twist, "/r1/cmd_vel", 10)
+    ros_bed.add(probe)
+    record = tmp_path / "truth.json"
+    node = PlaygroundNode(
+        context=ros_bed.context,
+        parameter_overrides=[
+            Parameter("world", value="crossing"),
+            Parameter("robots", value=2),
+            Parameter("speed_up", value=2.0),
+            Parameter("record", value=str(record)),
+        ],
+    )
+    ros_bed.add(node)
+    node.start()
+    try:
+        assert wait_for(lambda: all(len(received[f"/{r}/scan"]) >= 2 for r in ("r1", "r2")))
+        assert wait_for(lambda: received["/r1/tf_static"] and received["/r2/tf_static"])
+        for robot in ("r1", "r2"):
+            static = {
+                (t.header.frame_id, t.child_frame_id)
+                for m in received[f"/{robot}/tf_static"]
+                for t in m.transforms
+            }
+            assert static == {
+                (f"{robot}/base_footprint", f"{robot}/base_link"),
+                (f"{robot}/base_link", f"{robot}/base_laser"),
+            }
+            assert received[f"/{robot}/scan"][-1].header.frame_id == f"{robot}/base_laser"
+            odom = received[f"/{robot}/odom"][-1]
+            assert (odom.header.frame_id, odom.child_frame_id) == (
+                f"{robot}/odom", f"{robot}/base_footprint"
+            )
+            assert received[f"/{robot}/ground_truth"][-1].header.frame_id == f"{robot}/map"
+            tf_frames = {
+                t.header.frame_id for m in received[f"/{robot}/tf"] for t in m.transforms
+            }
+            assert tf_frames == {f"{robot}/odom"}
+        # Nothing on the single-robot names.
+        assert received["/scan"] == [] and received["/odom"] == [] and received["/tf"] == []
+        truth = {r: received[f"/{r}/ground_truth"][-1].pose.pose.position for r in ("r1", "r2")}
+        assert (truth["r1"].x, truth["r1"].y) == pytest.approx((1.5, 2.0))
+        assert (truth["r2"].x, truth["r2"].y) == pytest.approx((3.0, 6.0))
+        # r2 faces -y, its laser 0.1 m ahead at (3.0, 5.9): the beam towards r1's centre ends
+        # on r1's disc (radius 0.2; the map has nothing there; noise 0.01 m).
+        scan = received["/r2/scan"][-1]
+        bearing = math.atan2(2.0 - 5.9, 1.5 - 3.0) - (-1.5708)
+        beam = round((bearing - scan.angle_min) / scan.angle_increment) % len(scan.ranges)
+        assert scan.ranges[beam] == pytest.approx(math.hypot(1.5, 3.9) - 0.2, abs=0.05)
+
+        command = Twist()
+        command.linear.x = 0.3
+
+        def r1_moved() -> bool:
+            r1_cmd.publish(command)
+            return received["/r1/ground_truth"][-1].pose.pose.position.x > 1.7
+
+        assert wait_for(r1_moved, 20.0)
+    finally:
+        node.stop()
+    data = json.loads(record.read_text())
+    assert set(data["robots"]) == {"r1", "r2"}
+    assert data["robots"]["r1"]["commands_received"] >= 1
+    assert data["robots"]["r2"]["commands_received"] == 0
+    assert data["robots"]["r2"]["true_poses"][-1][1:3] == pytest.approx([3.0, 6.0])
+    assert data["robots"]["r1"]["collisions"] == [] and data["world"] == "crossing"
+
+
+def test_robots_beyond_the_worlds_list_are_refused(ros_bed):
+    from rclpy.parameter import Parameter
+
+    from easynav.playground.ros.playground_node import PlaygroundNode
+
+    with pytest.raises(ValueError, match="declares 2 robot"):
+        PlaygroundNode(
+            context=ros_bed.context,
+            parameter_overrides=[
+                Parameter("world", value="crossing"), Parameter("robots", value=3)
+            ],
+        )
+    with pytest.raises(ValueError, match="declares 0 robot"):
+        PlaygroundNode(context=ros_bed.context, parameter_overrides=[Parameter("robots", value=2)])

@@ -1,4 +1,5 @@
-"""Built-in worlds generated in code: a house and an office, drawn with rectangles in metres.
+"""Built-in worlds generated in code: a house, an office and a hall for two robots (crossing),
+drawn with rectangles in metres.
 
 The shipped ``worlds/<name>.map`` files are these grids saved (regenerate them with
 ``python -m easynav.playground.builtin_worlds``; a test checks that they match). Walls and
@@ -87,7 +88,25 @@ def build_office() -> World:
     return World(c.grid, RESOLUTION, 0.0, 0.0, name="office")
 
 
-BUILTIN_WORLDS: dict[str, Callable[[], World]] = {"home": build_home, "office": build_office}
+def build_crossing() -> World:
+    """A 10 x 7 m hall for two robots whose paths cross (worlds/crossing.yaml): open in the
+    middle, with pillars and cabinets along the walls for the localizer; 0.05 m cells."""
+    c = _Canvas(10.0, 7.0)
+    c.outer_walls()
+    c.fill(0.1, 4.6, 0.7, 5.8)  # cabinet, west wall
+    c.fill(6.0, 6.3, 7.6, 6.9)  # shelf, north wall
+    c.fill(9.3, 0.1, 9.9, 1.0)  # cabinet, south-east corner
+    c.fill(5.4, 4.4, 5.8, 4.8)  # pillar
+    c.fill(7.6, 3.6, 8.0, 4.0)  # pillar
+    c.fill(1.2, 0.1, 2.2, 0.5)  # low bench, south wall
+    return World(c.grid, RESOLUTION, 0.0, 0.0, name="crossing")
+
+
+BUILTIN_WORLDS: dict[str, Callable[[], World]] = {
+    "home": build_home,
+    "office": build_office,
+    "crossing": build_crossing,
+}
 
 
 def write_builtin_maps(directory: str | Path) -> list[Path]:

@@ -24,6 +24,16 @@ _IMU_KEYS = {"rate", "gyro_noise", "gyro_bias", "accel_noise", "yaw_noise"}
 _GNSS_KEYS = {"rate", "noise", "jump_probability", "jump_distance", "outages"}
 
 
+@dataclass(frozen=True)
+class RobotEntry:
+    """One robot of a multi-robot world: its ``name`` (namespace and tf_prefix), start pose
+    and waypoint file (None: none)."""
+
+    name: str
+    start_pose: tuple[float, float, float]
+    waypoints_path: Path | None = None
+
+
 @dataclass
 class WorldDescription:
     """Everything the playground needs to set up a run.
@@ -54,6 +64,11 @@ class WorldDescription:
         terrain:                       # optional: ground heights (flat without the key)
           elevation: maps/uneven_terrain.yaml  # a gridmap file (GridmapMapsManager's formats)
           max_climb_slope_deg: 30.0    # the robot cannot climb steeper ground (Terrain)
+        robots:                        # optional: several robots (`--robots N` takes the first
+          - name: r1                   # N); each its namespace, tf_prefix, start and waypoints
+            start_pose: [1.0, 1.0, 0.0]
+            waypoints: crossing.r1.waypoints.yaml
+          - {name: r2, start_pose: [5.0, 1.0, 3.14], waypoints: crossing.r2.waypoints.yaml}
 
     Thread contract: plain data; build it before starting threads.
     """
@@ -71,6 +86,22 @@ class WorldDescription:
     furniture: list[BoxObstacle] = field(default_factory=list)
     terrain_path: Path | None = None
     max_climb_slope_deg: float = 30.0
+    robots: list[RobotEntry] = field(default_factory=list)
+
+    def fleet(self, count: int) -> list[RobotEntry]:
+        """The first ``count`` robots of :attr:`robots` (a multi-robot run).
+
+        Raises:
+            ValueError: ``count`` < 2, or more robots than the world declares (names both).
+        """
+        if count < 2:
+            raise ValueError(f"a fleet has at least 2 robots, got {count}")
+        if len(self.robots) < count:
+            raise ValueError(
+                f"world '{self.world.name}' ({self.source or 'built in'}) declares "
+                f"{len(self.robots)} robot(s) in 'robots', {count} asked for"
+            )
+        return self.robots[:count]
 
     def make_terrain(self) -> Terrain | None:
         """The world's :class:`Terrain` (heights from :attr:`terrain_path`, the climb limit),
@@ -192,7 +223,7 @@ class WorldDescription:
             raise ValueError(f"{path}: a world description needs a 'map' key")
         unknown = set(data) - {
             "map", "start_pose", "waypoints", "moving_obstacles", "robot", "furniture",
-            "geodetic_origin", "imu", "gnss", "terrain",
+            "geodetic_origin", "imu", "gnss", "terrain", "robots",
         }
         if unknown:
             raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
@@ -251,6 +282,7 @@ class WorldDescription:
             if not (isinstance(climb, (int, float)) and 0.0 < climb < 90.0):
                 raise ValueError(f"{path}: terrain.max_climb_slope_deg must be in (0, 90) deg, "
                                  f"got {climb!r}")
+        robots = _robot_entries(data.get("robots"), path)
         return cls(
             world,
             map_path=map_path,
@@ -265,7 +297,42 @@ class WorldDescription:
             furniture=boxes,
             terrain_path=terrain_path,
             max_climb_slope_deg=float(climb),
+            robots=robots,
         )
+
+
+def _robot_entries(data: object, path: Path) -> list[RobotEntry]:
+    """Parse a world's ``robots`` list (see :class:`WorldDescription`).
+
+    Raises:
+        ValueError: not a list of mappings with a unique ``name`` (letters, digits and ``_``,
+            not starting with a digit: a ROS namespace) and a finite ``[x, y, yaw]``
+            ``start_pose``, or unknown keys.
+    """
+    if data is None:
+        return []
+    if not isinstance(data, list):
+        raise ValueError(f"{path}: robots must be a list, got {data!r}")
+    entries = []
+    for i, spec in enumerate(data):
+        where = f"{path}: robots[{i}]"
+        if not isinstance(spec, dict) or set(spec) - {"name", "start_pose", "waypoints"}:
+            raise ValueError(f"{where} must be a mapping with keys among name, start_pose, "
+                             f"waypoints, got {spec!r}")
+        name = spec.get("name")
+        if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
+            raise ValueError(f"{where}.name must be a ROS name (letters, digits, _), got {name!r}")
+        start = spec.get("start_pose")
+        if not (isinstance(start, list) and len(start) == 3
+                and all(isinstance(v, (int, float)) and math.isfinite(v) for v in start)):
+            raise ValueError(f"{where}.start_pose must be [x, y, yaw], got {start!r}")
+        waypoints = spec.get("waypoints")
+        entries.append(RobotEntry(name, tuple(float(v) for v in start),
+                                  path.parent / waypoints if waypoints else None))
+    names = [e.name for e in entries]
+    if len(set(names)) != len(names):
+        raise ValueError(f"{path}: robot names must be unique, got {names}")
+    return entries
 
 
 def load_waypoints(path: str | Path) -> list[tuple[float, float, float]]:

@@ -30,6 +30,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--seed", type=int, help="random seed of sensor noise (default 0)")
     parser.add_argument(
+        "--robots",
+        type=int,
+        help="number of robots (default 1); more than one: the world's first N 'robots', "
+        "each with its topics under its name (r1/scan...) and its frames prefixed (r1/odom...)",
+    )
+    parser.add_argument(
         "--start",
         type=float,
         nargs=3,
@@ -82,6 +88,7 @@ def main(argv: list[str] | None = None) -> int:
         ("world", "world"),
         ("speed_up", "speed_up"),
         ("seed", "seed"),
+        ("robots", "robots"),
         ("start", "start_pose"),
         ("step", "step"),
         ("record", "record"),
@@ -116,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
                 last_report = time.monotonic()
                 node.get_logger().info(
                     f"t={node.sim.time:.1f} s simulated, x{node.real_time_factor:.2f} real time, "
-                    f"{len(node.sim.checker.collisions)} collision(s)"
+                    f"{node.collision_count} collision(s)"
                 )
     except (ValueError, FileNotFoundError, KeyError) as err:
         print(f"easynav-playground: {err}", file=sys.stderr)

@@ -4,24 +4,22 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from pathlib import Path
 
 import numpy as np
-from geometry_msgs.msg import Pose2D, Twist, TwistStamped
+from geometry_msgs.msg import Twist
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
-from std_msgs.msg import Bool, String
 
-from easynav.core.tf import StaticTFBroadcaster, TFBroadcaster
 from easynav.playground.fixed_rate_loop import FixedRateLoop
 from easynav.playground.ros import messages
+from easynav.playground.ros.robot_port import FRAME_KEYS, RobotPort
 from easynav.playground.sim import (
     BaseLimits,
-    Collision,
     DiffDriveRobot,
+    Fleet,
     GnssReceiver,
     ImuSensor,
     LaserScanner,
@@ -37,6 +35,7 @@ DEFAULT_PARAMETERS: dict[str, object] = {
     "world": "home",
     "speed_up": 1.0,
     "seed": 0,
+    "robots": 1,
     "step": 0.005,
     "start_pose": [math.nan, math.nan, math.nan],
     "robot_radius": 0.2,
@@ -129,6 +128,14 @@ class PlaygroundNode(Node):
     stopped, with no odometry of the move: a kidnapped robot; a pose in collision is refused
     with a warning). It publishes /clock; it does not use it.
 
+    With ``robots`` N > 1 the world's first N ``robots`` (:class:`WorldDescription`) share the
+    world in a :class:`Fleet` (each laser sees the others, collisions between them are
+    recorded): each robot's topics above are under its name (``r1/scan``, ``r1/odom``,
+    ``r1/cmd_vel``, ``r1/tf``, ``r1/tf_static``, ``r1/playground/hold``...) and its frames are
+    prefixed with it (``r1/odom``, ``r1/base_footprint``, ``r1/map``...: a
+    :class:`RobotPort` each); ``/clock`` and ``playground/world`` are shared, and the record
+    holds each robot's ground truth under ``robots``. ``start_pose`` is for one robot only.
+
     Thread contract: construct, :meth:`start` and :meth:`stop` from the main thread. Command
     callbacks run in the executor thread and only hand the command to the simulation (under
     its lock); the simulation loop thread steps and publishes.
@@ -160,19 +167,88 @@ class PlaygroundNode(Node):
             raise ValueError(f"playground: speed_up must be finite and > 0, got {speed_up}")
         self.speed_up = speed_up
         seed = int(p("seed"))
+        count = int(p("robots"))
+        if count < 1:
+            raise ValueError(f"playground: robots must be >= 1, got {count}")
         start = [float(v) for v in p("start_pose")]
         if len(start) != 3:
             raise ValueError(f"playground: start_pose must be [x, y, yaw], got {start}")
-        if any(math.isnan(v) for v in start):
-            start = list(self.description.start_pose)
-        self.start_pose = tuple(start)
-        # Children by index: adding sensors at the end leaves the earlier streams unchanged.
-        rng_scan, rng_odom, rng_lidar, rng_imu, rng_gnss = (
-            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(5)
+        if count == 1:
+            if any(math.isnan(v) for v in start):
+                start = list(self.description.start_pose)
+            robots = [("", tuple(start))]
+        else:
+            if not all(math.isnan(v) for v in start):
+                raise ValueError(
+                    "playground: start_pose is for one robot; with robots > 1 the start poses "
+                    "are the world's ('robots' of its description)"
+                )
+            robots = [(e.name, e.start_pose) for e in self.description.fleet(count)]
+        self.start_pose = robots[0][1]
+        self.start_poses = [pose for _name, pose in robots]
+        self.robot_names = [name for name, _pose in robots]
+        # Five noise streams per robot, children by index: adding sensors at the end leaves
+        # the earlier streams unchanged, and the first robot's are those of a robot alone.
+        streams = np.random.SeedSequence(seed).spawn(5 * count)
+        rngs = [np.random.default_rng(s) for s in streams]
+        self._lidar_offset = tuple(float(p(f"lidar.{k}")) for k in ("x", "y", "z", "yaw"))
+        self.terrain = None
+        if self.description.terrain_path is not None:
+            self.terrain = Terrain.load(
+                self.description.terrain_path, float(p("terrain.max_climb_slope_deg"))
+            )
+        obstacles = self.description.make_obstacles() if p("moving_obstacles") else []
+        simulations = [
+            self._make_simulation(pose, rngs[5 * i:5 * i + 5], obstacles if count == 1 else [])
+            for i, (_name, pose) in enumerate(robots)
+        ]
+        #: What the loop steps: the robot's Simulation, or the Fleet of several.
+        self.fleet = None
+        self._stepper = simulations[0]
+        if count > 1:
+            self.fleet = Fleet(simulations, self.robot_names, obstacles=obstacles)
+            self._stepper = self.fleet
+        self.sim = simulations[0]
+        self.scanner = self.sim.scanner
+        self.lidar = self.sim.lidar
+        self.record_path = str(p("record"))
+        frames = {k: str(p(k)) for k in FRAME_KEYS}
+        for sim in simulations:
+            sim.set_held(bool(p("hold")))
+        self._clock_pub = self.create_publisher(Clock, "/clock", _RELIABLE)
+        self._world_pub = self.create_publisher(
+            messages.OccupancyGrid, "playground/world", _LATCHED
         )
+        self.ports = [
+            RobotPort(
+                self, name, sim, frames,
+                imu=self._make_imu(rngs[5 * i + 3]),
+                gnss=self._make_gnss(rngs[5 * i + 4]),
+                terrain=self.terrain,
+                base_link_height=float(p("base_link_height")),
+                laser_z=float(p("laser.z")),
+                lidar_offset=self._lidar_offset,
+            )
+            for i, (name, sim) in enumerate(zip(self.robot_names, simulations, strict=True))
+        ]
+        self.frames = self.ports[0].frames
+        self.imu = self.ports[0].imu
+        self.gnss = self.ports[0].gnss
+        self._loop = FixedRateLoop(
+            self.sim.step_size / self.speed_up, self._tick, max_lag=0.25, name="playground-sim"
+        )
+
+    def _param(self, name: str):
+        return self.get_parameter(name).value
+
+    def _make_simulation(self, start_pose, rngs, obstacles) -> Simulation:
+        """One robot at ``start_pose`` with noise streams ``rngs`` (scan, odometry, lidar,
+        IMU, GNSS)."""
+        p = self._param
+        rng_scan, rng_odom, rng_lidar = rngs[:3]
         limits = BaseLimits(**{k: float(p(f"base.{k}")) for k in BaseLimits.__slots__})
-        robot = DiffDriveRobot(*self.start_pose, limits=limits, cmd_timeout=float(p("cmd_timeout")))
-        self.scanner = LaserScanner(
+        robot = DiffDriveRobot(*start_pose, limits=limits, cmd_timeout=float(p("cmd_timeout")))
+        scanner = LaserScanner(
             beams=int(p("laser.beams")),
             fov=float(p("laser.fov")),
             min_range=float(p("laser.min_range")),
@@ -189,10 +265,9 @@ class PlaygroundNode(Node):
             drift_per_metre=float(p("odometry.drift_per_metre")),
             rng=rng_odom,
         )
-        obstacles = self.description.make_obstacles() if p("moving_obstacles") else []
-        self.lidar = None
+        lidar = None
         if bool(p("lidar.enabled")):
-            self.lidar = Lidar3D(
+            lidar = Lidar3D(
                 rings=int(p("lidar.rings")),
                 beams=int(p("lidar.beams")),
                 min_elevation=float(p("lidar.min_elevation")),
@@ -203,16 +278,10 @@ class PlaygroundNode(Node):
                 noise_std=float(p("lidar.noise_std")),
                 rng=rng_lidar,
             )
-        self._lidar_offset = tuple(float(p(f"lidar.{k}")) for k in ("x", "y", "z", "yaw"))
-        self.terrain = None
-        if self.description.terrain_path is not None:
-            self.terrain = Terrain.load(
-                self.description.terrain_path, float(p("terrain.max_climb_slope_deg"))
-            )
-        self.sim = Simulation(
+        return Simulation(
             self.description.world,
             robot,
-            self.scanner,
+            scanner,
             odometry,
             obstacles=obstacles,
             robot_radius=float(p("robot_radius")),
@@ -222,136 +291,58 @@ class PlaygroundNode(Node):
             boxes=self.description.furniture,
             robot_height=float(p("robot_height")),
             laser_height=float(p("laser.z")),
-            lidar=self.lidar,
+            lidar=lidar,
             lidar_offset=self._lidar_offset,
             terrain=self.terrain,
         )
-        self.record_path = str(p("record"))
-        self.frames = {
-            k: str(p(k))
-            for k in (
-                "map_frame",
-                "odom_frame",
-                "robot_footprint_frame",
-                "robot_frame",
-                "laser_frame",
-                "lidar_frame",
-            )
-        }
-        self.sim.set_held(bool(p("hold")))
-        self._base_link_height = float(p("base_link_height"))
-        self._laser_z = float(p("laser.z"))
 
-        self._clock_pub = self.create_publisher(Clock, "/clock", _RELIABLE)
-        self._scan_pub = self.create_publisher(messages.LaserScan, "scan", _RELIABLE)
-        self._cloud_pub = None
-        if self.lidar is not None:
-            from sensor_msgs.msg import PointCloud2
+    def _make_imu(self, rng) -> ImuSensor | None:
+        p = self._param
+        if not p("imu.enabled"):
+            return None
+        return ImuSensor(
+            rate=float(p("imu.rate")), gyro_noise=float(p("imu.gyro_noise")),
+            gyro_bias=float(p("imu.gyro_bias")), accel_noise=float(p("imu.accel_noise")),
+            yaw_noise=float(p("imu.yaw_noise")), rng=rng)
 
-            self._cloud_pub = self.create_publisher(PointCloud2, "points", _RELIABLE)
-        self._odom_pub = self.create_publisher(messages.Odometry, "odom", _RELIABLE)
-        self._truth_pub = self.create_publisher(messages.Odometry, "ground_truth", _RELIABLE)
-        self._collisions_pub = self.create_publisher(String, "collisions", _LATCHED)
-        self._world_pub = self.create_publisher(
-            messages.OccupancyGrid, "playground/world", _LATCHED
-        )
-        self._tf = TFBroadcaster(self)
-        self._tf_static = StaticTFBroadcaster(self)
-        self.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, _RELIABLE)
-        self.create_subscription(
-            TwistStamped, "cmd_vel_stamped", self._on_cmd_vel_stamped, _RELIABLE
-        )
-        # Transient local, so that a latched hold published before this node started applies.
-        self.create_subscription(Bool, "playground/hold", self._on_hold, _LATCHED)
-        self.create_subscription(Pose2D, "playground/teleport", self._on_teleport, _RELIABLE)
-        self._warned_lateral = False
-        self._rejected_commands = 0
-
-        self.imu = None
-        self.gnss = None
-        if p("imu.enabled"):
-            self.imu = ImuSensor(
-                rate=float(p("imu.rate")), gyro_noise=float(p("imu.gyro_noise")),
-                gyro_bias=float(p("imu.gyro_bias")), accel_noise=float(p("imu.accel_noise")),
-                yaw_noise=float(p("imu.yaw_noise")), rng=rng_imu)
-            self._imu_pub = self.create_publisher(messages.Imu, "imu/data", _RELIABLE)
-            self.sim.add_periodic(self.imu.period, self._publish_imu)
-        if p("gnss.enabled"):
-            origin = [float(v) for v in p("geodetic_origin")]
-            if len(origin) != 3 or not all(math.isfinite(v) for v in origin):
-                raise ValueError(f"playground: gnss needs geodetic_origin [lat, lon, alt], got "
-                                 f"{origin}")
-            flat = [float(v) for v in p("gnss.outages")]
-            if len(flat) % 2:
-                raise ValueError(f"playground: gnss.outages must be [start, end, ...] pairs, "
-                                 f"got {flat}")
-            self.gnss = GnssReceiver(
-                origin, rate=float(p("gnss.rate")), noise=float(p("gnss.noise")),
-                jump_probability=float(p("gnss.jump_probability")),
-                jump_distance=float(p("gnss.jump_distance")),
-                outages=[flat[i:i + 2] for i in range(0, len(flat), 2)], rng=rng_gnss)
-            self._gnss_pub = self.create_publisher(messages.NavSatFix, "gps/fix", _RELIABLE)
-            self.sim.add_periodic(self.gnss.period, self._publish_gnss)
-        self.frames["imu_frame"] = str(p("imu_frame"))
-        self.frames["gnss_frame"] = str(p("gnss_frame"))
-
-        self.sim.on_scan.append(self._publish_scan)
-        self.sim.on_cloud.append(self._publish_cloud)
-        self.sim.on_odometry.append(self._publish_odometry)
-        self.sim.on_collision.append(self._publish_collision)
-        self._loop = FixedRateLoop(
-            self.sim.step_size / self.speed_up, self._tick, max_lag=0.25, name="playground-sim"
-        )
-
-    def _param(self, name: str):
-        return self.get_parameter(name).value
+    def _make_gnss(self, rng) -> GnssReceiver | None:
+        p = self._param
+        if not p("gnss.enabled"):
+            return None
+        origin = [float(v) for v in p("geodetic_origin")]
+        if len(origin) != 3 or not all(math.isfinite(v) for v in origin):
+            raise ValueError(f"playground: gnss needs geodetic_origin [lat, lon, alt], got "
+                             f"{origin}")
+        flat = [float(v) for v in p("gnss.outages")]
+        if len(flat) % 2:
+            raise ValueError(f"playground: gnss.outages must be [start, end, ...] pairs, "
+                             f"got {flat}")
+        return GnssReceiver(
+            origin, rate=float(p("gnss.rate")), noise=float(p("gnss.noise")),
+            jump_probability=float(p("gnss.jump_probability")),
+            jump_distance=float(p("gnss.jump_distance")),
+            outages=[flat[i:i + 2] for i in range(0, len(flat), 2)], rng=rng)
 
     # ------------------------------------------------------------------ lifecycle
     def start(self) -> None:
         """Publish the latched and static data, then start the simulation loop thread."""
-        f = self.frames
-        lidar_tf = []
-        if self.lidar is not None:
-            ox, oy, oz, oyaw = self._lidar_offset
-            lidar_tf.append(
-                messages.planar_transform_msg(
-                    0.0, f["robot_frame"], f["lidar_frame"], ox, oy,
-                    oz - self._base_link_height, oyaw,
-                )
-            )
-        self._tf_static.send_transform(
-            lidar_tf + [
-                messages.planar_transform_msg(
-                    0.0,
-                    f["robot_footprint_frame"],
-                    f["robot_frame"],
-                    0.0,
-                    0.0,
-                    self._base_link_height,
-                ),
-                messages.planar_transform_msg(
-                    0.0,
-                    f["robot_frame"],
-                    f["laser_frame"],
-                    self.sim.laser_offset[0],
-                    self.sim.laser_offset[1],
-                    self._laser_z - self._base_link_height,
-                    self.sim.laser_offset[2],
-                ),
-            ]
-            # The outdoor sensors sit on the base (only in worlds that have them).
-            + [messages.planar_transform_msg(0.0, f["robot_frame"], f[frame], 0.0, 0.0)
-               for frame, sensor in (("imu_frame", self.imu), ("gnss_frame", self.gnss))
-               if sensor is not None]
-        )
+        for port in self.ports:
+            port.start()
         self._world_pub.publish(
-            messages.occupancy_grid_msg(self.description.world, 0.0, f["map_frame"])
+            messages.occupancy_grid_msg(self.description.world, 0.0, self.frames["map_frame"])
         )
-        self._collisions_pub.publish(String(data=json.dumps({"count": 0, "last": None})))
         x, y, yaw = self.start_pose
+        where = (
+            f"start ({x:.2f}, {y:.2f}, {yaw:.2f})"
+            if self.fleet is None
+            else f"{len(self.ports)} robots: " + ", ".join(
+                f"{name} at ({pose[0]:.2f}, {pose[1]:.2f}, {pose[2]:.2f})"
+                for name, pose in zip(self.robot_names, self.start_poses, strict=True)
+            )
+        )
         self.get_logger().info(
             f"world '{self.description.world.name}' ({self.description.source or 'built in'}), "
-            f"start ({x:.2f}, {y:.2f}, {yaw:.2f}), step {self.sim.step_size * 1000:.1f} ms, "
+            f"{where}, step {self.sim.step_size * 1000:.1f} ms, "
             f"speed-up x{self.speed_up:g}, {len(self.sim.obstacles)} moving obstacle(s)"
             + (f", terrain {self.description.terrain_path.name} (climbs up to "
                f"{self.terrain.max_climb_slope_deg:g} deg)" if self.terrain is not None else "")
@@ -371,25 +362,31 @@ class PlaygroundNode(Node):
                 self.write_record(self.record_path)
 
     def write_record(self, path: str | Path) -> None:
-        """Save the ground truth (trajectory, clearances, collisions) and run statistics."""
-        rec = self.sim.recorder
-        data = rec.to_dict()
-        data["sim_time"] = self.sim.time
+        """Save the ground truth (trajectory, clearances, collisions) and run statistics.
+
+        One robot: its record at the top level. Several: ``robots`` maps each name to its
+        record (the same keys), beside ``sim_time``, ``wall_time`` and ``world``.
+        """
+        if self.fleet is None:
+            data = self.ports[0].record(self.start_pose)
+        else:
+            data = {
+                "robots": {
+                    port.name: port.record(pose)
+                    for port, pose in zip(self.ports, self.start_poses, strict=True)
+                },
+                "sim_time": self.sim.time,
+            }
         data["wall_time"] = self._loop.elapsed()
-        data["commands_received"] = self.sim.commands_received
-        data["commands_rejected"] = self._rejected_commands
-        data["start_pose"] = list(self.start_pose)
-        data["holds"] = [list(event) for event in self.sim.hold_events]
-        data["teleports"] = [list(event) for event in self.sim.teleport_events]
-        data["commands"] = [list(event) for event in self.sim.command_events]
-        data["obstacles"] = [
-            {"name": o.name, "started_at": getattr(o, "started_at", 0.0)}
-            for o in self.sim.obstacles
-        ]
         data["world"] = self.description.world.name
         tmp = Path(path).with_name(Path(path).name + ".tmp")
         tmp.write_text(json.dumps(data))
         tmp.replace(path)
+
+    @property
+    def collision_count(self) -> int:
+        """Collisions of every robot so far."""
+        return sum(len(port.sim.checker.collisions) for port in self.ports)
 
     @property
     def real_time_factor(self) -> float:
@@ -409,112 +406,16 @@ class PlaygroundNode(Node):
         clock = Clock()
         clock.clock = messages.stamp_msg((self.sim.steps + 1) * self.sim.step_size)
         self._clock_pub.publish(clock)
-        self.sim.step()
-
-    def _publish_scan(self, stamp: float, ranges: np.ndarray) -> None:
-        self._scan_pub.publish(
-            messages.laser_scan_msg(self.scanner, ranges, stamp, self.frames["laser_frame"])
-        )
-
-    def _publish_cloud(self, stamp: float, points: np.ndarray) -> None:
-        from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
-
-        self._cloud_pub.publish(
-            point_cloud2_from_points(points, self.frames["lidar_frame"], stamp)
-        )
-
-    def _publish_odometry(self, stamp: float) -> None:
-        f = self.frames
-        odom = self.sim.odometry
-        self._odom_pub.publish(
-            messages.planar_odometry_msg(
-                stamp,
-                f["odom_frame"],
-                f["robot_footprint_frame"],
-                (odom.x, odom.y, odom.yaw),
-                (odom.v, odom.w),
-                pose_variance=(0.01, 0.01),
-            )
-        )
-        self._tf.send_transform(
-            messages.planar_transform_msg(
-                stamp, f["odom_frame"], f["robot_footprint_frame"], odom.x, odom.y, 0.0, odom.yaw
-            )
-        )
-        robot = self.sim.robot
-        truth = messages.planar_odometry_msg(
-            stamp,
-            f["map_frame"],
-            f["robot_footprint_frame"],
-            (robot.x, robot.y, robot.yaw),
-            (robot.v, robot.w),
-        )
-        if self.terrain is not None:
-            truth.pose.pose.position.z = self.terrain.height(robot.x, robot.y)
-        self._truth_pub.publish(truth)
-
-    def _publish_imu(self, stamp: float) -> None:
-        robot = self.sim.robot
-        reading = self.imu.sample(stamp, robot.yaw, robot.v, robot.w)
-        self._imu_pub.publish(messages.imu_msg(reading, self.frames["imu_frame"]))
-
-    def _publish_gnss(self, stamp: float) -> None:
-        robot = self.sim.robot
-        fix = self.gnss.fix(stamp, robot.x, robot.y)
-        self._gnss_pub.publish(messages.nav_sat_fix_msg(fix, self.frames["gnss_frame"]))
-
-    def _publish_collision(self, collision: Collision) -> None:
-        count = len(self.sim.checker.collisions)
-        self.get_logger().warning(
-            f"collision #{count} with {collision.with_what} at ({collision.x:.2f}, "
-            f"{collision.y:.2f}), t={collision.stamp:.2f} s"
-        )
-        self._collisions_pub.publish(
-            String(data=json.dumps({"count": count, "last": collision.as_dict()}))
-        )
+        self._stepper.step()
 
     # ------------------------------------------------------------------ executor thread
-    def _on_hold(self, msg: Bool) -> None:
-        if bool(msg.data) != self.sim.held:
-            self.sim.set_held(msg.data)
-            self.get_logger().warning(
-                f"robot {'held in place (wheels blocked)' if msg.data else 'released'} at "
-                f"t={self.sim.time:.2f} s"
-            )
-
-    def _on_teleport(self, msg: Pose2D) -> None:
-        try:
-            self.sim.teleport(msg.x, msg.y, msg.theta)
-        except ValueError as exc:
-            self.get_logger().warning(f"playground/teleport refused: {exc}")
-            return
-        self.get_logger().warning(
-            f"teleport to ({msg.x:.2f}, {msg.y:.2f}, {msg.theta:.2f}) at t={self.sim.time:.2f} s "
-            "(no odometry of the move; refused at the next step if in collision)"
-        )
-
     def _on_cmd_vel(self, msg: Twist) -> None:
-        self._command(msg)
+        """The first robot's ``cmd_vel`` callback (tests call it directly)."""
+        self.ports[0].on_cmd_vel(msg)
 
-    def _on_cmd_vel_stamped(self, msg: TwistStamped) -> None:
-        self._command(msg.twist)
-
-    def _command(self, twist: Twist) -> None:
-        lin, ang = twist.linear, twist.angular
-        if not self._warned_lateral and (lin.y or lin.z or ang.x or ang.y):
-            self._warned_lateral = True
-            self.get_logger().warning(
-                f"cmd_vel with linear.y={lin.y}, linear.z={lin.z}, angular.x={ang.x}, "
-                f"angular.y={ang.y}: a differential drive only executes linear.x and angular.z"
-                " (warned once)"
-            )
-        try:
-            self.sim.set_command(lin.x, ang.z, time.time())
-        except ValueError as err:
-            # A driver must not keep moving on garbage: stop and say why.
-            self._rejected_commands += 1
-            self.sim.set_command(0.0, 0.0)
-            self.get_logger().error(f"rejected cmd_vel, stopping the base: {err}")
+    @property
+    def _rejected_commands(self) -> int:
+        return self.ports[0].rejected_commands
 
 
 def parameter_overrides(values: dict[str, object]) -> list[Parameter]:
