@@ -184,3 +184,62 @@ def planner_plugins(params_path: Path) -> list[str]:
         return []
     planner = _ros_parameters(params, "planner_node") or {}
     return [str(_get(planner, f"{a}.plugin", "")) for a in planner.get("planner_types", []) or []]
+
+
+def derive_fleet_params(
+    params_path: Path,
+    map_file: Path,
+    robots: list[tuple[str, tuple[float, float, float]]],
+    out_path: Path,
+    **kwargs,
+) -> tuple[list[str], dict[str, str | None]]:
+    """Write ``out_path``: one params file for several robots, the original's multi-robot
+    layout (``r1/controller_node: ros__parameters: ...``, one section per robot and node).
+
+    Each robot ``(name, start_pose)`` gets the sections :func:`derive_params` derives for it
+    (``kwargs`` are its options), under ``<name>/<node>``, with ``system_node.tf_prefix`` set to
+    its name (frames ``r1/map``, ``r1/odom``, ``r1/base_footprint``...) and every sensor topic
+    made relative (``/scan`` becomes ``scan``: ``/r1/scan`` in namespace ``r1``). Run each with
+    ``easynav run OUT --namespace NAME`` (or ``--ros-args -r __ns:=/NAME``).
+
+    Returns the notes and each robot's planner path topic (``/r1/planner_node/<alias>/path``;
+    None without a planner).
+
+    Raises:
+        FileNotFoundError: no params file.
+        ValueError: not an EasyNav params file, or one with namespaced sections already.
+    """
+    document: dict = {}
+    notes: list[str] = []
+    path_topics: dict[str, str | None] = {}
+    for name, start_pose in robots:
+        part = Path(out_path).with_name(f"{Path(out_path).stem}.{name}.part.yaml")
+        robot_notes, path_topic = derive_params(params_path, map_file, start_pose, part, **kwargs)
+        params = yaml.safe_load(part.read_text())
+        part.unlink()
+        if not notes:
+            notes += robot_notes
+        for node, section in params.items():
+            if "/" in str(node) or "*" in str(node):
+                raise ValueError(
+                    f"{params_path}: section {node!r} is namespaced already; give a "
+                    "single-robot file (the robots' sections are derived from it)"
+                )
+            document[f"{name}/{node}"] = section
+        system = document.setdefault(f"{name}/system_node", {}).setdefault(
+            "ros__parameters", {}
+        )
+        system["tf_prefix"] = name
+        sensors = _ros_parameters(document, f"{name}/sensors_node") or {}
+        for sensor in sensors.get("sensors", []) or []:
+            topic = _get(sensors, f"{sensor}.topic")
+            if isinstance(topic, str) and topic.startswith("/"):
+                _set(sensors, f"{sensor}.topic", topic.lstrip("/"))
+        path_topics[name] = f"/{name}{path_topic}" if path_topic else None
+    names = [name for name, _ in robots]
+    notes.append(
+        f"one section per robot and node ({', '.join(f'{n}/...' for n in names)}), "
+        "system_node.tf_prefix = the robot's name, sensor topics relative to its namespace"
+    )
+    Path(out_path).write_text(yaml.safe_dump(document, sort_keys=False))
+    return notes, path_topics
