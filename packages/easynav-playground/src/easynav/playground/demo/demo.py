@@ -422,9 +422,15 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--world",
-        default="home",
         help="shipped world (home, office), a world "
-        "YAML, a map-server YAML or a .map file (default: home)",
+        "YAML, a map-server YAML or a .map file (default: home; crossing with --robots)",
+    )
+    parser.add_argument(
+        "--robots",
+        type=int,
+        default=1,
+        help="number of robots (default 1); more: the world's first N 'robots', one EasyNav "
+        "each in its namespace (r1, r2...) with its tf_prefix, their waypoints at once",
     )
     parser.add_argument(
         "--params", help=f"EasyNav params file (default: the playground's {DEFAULT_PARAMS.name})"
@@ -465,8 +471,30 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """``easynav demo`` / ``easynav-playground-demo``: parse options, run, return the exit code."""
     args = build_parser().parse_args(argv)
+    if args.robots < 1:
+        print(f"easynav demo: --robots must be >= 1, got {args.robots}", file=sys.stderr)
+        return EXIT_USAGE
+    if args.robots > 1:
+        from easynav.playground.demo.fleet_demo import run_fleet_demo
+
+        if args.waypoints:
+            print("easynav demo: with --robots the waypoints are each robot's in the world "
+                  "description (leave --waypoints out)", file=sys.stderr)
+            return EXIT_USAGE
+        return run_fleet_demo(
+            world=args.world or "crossing",
+            robots=args.robots,
+            params_file=args.params,
+            speed_up=args.speed_up,
+            output_png=args.output,
+            timeout=args.timeout,
+            seed=args.seed,
+            moving_obstacles=not args.no_obstacles,
+            domain_id=args.domain_id,
+            run_dir=args.run_dir,
+        )
     return run_demo(
-        world=args.world,
+        world=args.world or "home",
         params_file=args.params,
         waypoints=args.waypoints,
         speed_up=args.speed_up,

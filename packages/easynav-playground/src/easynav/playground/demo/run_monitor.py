@@ -44,6 +44,9 @@ class RunMonitor(Node):
     - ``/tf``: ``map -> odom`` (from EasyNav's localizer) composed with ``odom ->
       base_footprint`` (from the playground) gives EasyNav's pose estimate at each odometry
       stamp, recorded in :attr:`estimates` for the localisation error;
+    - with a ``frame_prefix`` (one robot of several, the node in the robot's namespace): its
+      own ``tf`` (``/r1/tf``) instead, the frames prefixed (``r1/map``...), and every frame
+      seen there without the prefix is kept in :attr:`foreign_frames` (a crossed tree);
     - ``cmd_vel`` / ``cmd_vel_stamped``: the velocity commands (their simulated arrival times);
     - ``collisions`` (latched JSON from the playground);
     - ``easynav_manager_info``: the goals still to visit and the distance to the current one;
@@ -58,12 +61,19 @@ class RunMonitor(Node):
         self,
         path_topic: str | None,
         frames: dict[str, str] | None = None,
+        frame_prefix: str = "",
         **kwargs,
     ) -> None:
         super().__init__(
             "easynav_demo", parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs
         )
-        self.frames = {"map": "map", "odom": "odom", "base": "base_footprint", **(frames or {})}
+        self.frame_prefix = frame_prefix
+        pre = f"{frame_prefix}/" if frame_prefix else ""
+        self.frames = {
+            "map": f"{pre}map", "odom": f"{pre}odom", "base": f"{pre}base_footprint",
+            **(frames or {}),
+        }
+        self.foreign_frames: set[str] = set()
         self.lock = threading.Lock()
         self.estimates = GroundTruthRecorder()
         self.truth: tuple[float, float, float, float] | None = None  # stamp, x, y, yaw
@@ -84,7 +94,9 @@ class RunMonitor(Node):
         )
         latest = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
         self.create_subscription(Odometry, "ground_truth", self._on_truth, latest)
-        self.create_subscription(TFMessage, "/tf", self._on_tf, reliable)
+        self.create_subscription(
+            TFMessage, "tf" if frame_prefix else "/tf", self._on_tf, reliable
+        )
         self.create_subscription(Twist, "cmd_vel", self._on_cmd, reliable)
         self.create_subscription(TwistStamped, "cmd_vel_stamped", self._on_cmd, reliable)
         self.create_subscription(String, "collisions", self._on_collisions, latched)
@@ -115,6 +127,14 @@ class RunMonitor(Node):
         f = self.frames
         for t in msg.transforms:
             parent, child = t.header.frame_id.lstrip("/"), t.child_frame_id.lstrip("/")
+            if self.frame_prefix:
+                foreign = {
+                    frame for frame in (parent, child)
+                    if not frame.startswith(f"{self.frame_prefix}/")
+                }
+                if foreign:
+                    with self.lock:
+                        self.foreign_frames |= foreign
             tr = t.transform
             pose = (tr.translation.x, tr.translation.y, _yaw(tr.rotation))
             if (parent, child) == (f["map"], f["odom"]):
