@@ -1,6 +1,6 @@
 """Two EasyNav instances in namespaces r1 and r2 (issue #21): one by ``namespace``, one by the
-original's ``--ros-args -r __ns:=/r2``; topics, TF topics and frames apart, one saved
-configuration file each."""
+original's ``--ros-args -r __ns:=/r2``, from one params file (sections ``r1/<node>`` and
+``/r2/<node>``); topics, TF topics and frames apart, one saved configuration file each."""
 
 from __future__ import annotations
 
@@ -44,7 +44,9 @@ def test_two_namespaced_instances_keep_apart_and_save_their_own_configuration(
                 "sensors_node.laser.type": "sensor_msgs/msg/LaserScan",
             }
         )
-        document.update({f"{robot}/{node}": section for node, section in params.items()})
+        # Both spellings of a namespaced section: the original's "r1/node" and ROS's "/r2/node".
+        key = robot if robot == "r1" else f"/{robot}"
+        document.update({f"{key}/{node}": section for node, section in params.items()})
     path = tmp_path / "fleet.yaml"
     path.write_text(yaml.safe_dump(document))
     log_dir = Path(os.environ["ROS_LOG_DIR"])
