@@ -138,3 +138,33 @@ def test_likelihood_field_counts_near_misses_softly():
     assert fractions[0] == pytest.approx((1.0 + field[0, 12]) / 2)
     with pytest.raises(ValueError, match="hit sigma = -1"):
         likelihood_field(grid, -1.0)
+
+
+def test_redrawn_particles_count_in_the_estimate_once_weighed():
+    # The cloud on (1, 1); a quarter redrawn at (9, 9), as a recovery redraw would: at the mean
+    # weight they would pull the estimate 2 m toward (9, 9) before any scan had weighed them.
+    pf = filter_with(400)
+    pf.poses[:] = (1.0, 1.0, 0.0)
+    pf.redraw(np.arange(100), np.tile((9.0, 9.0, 0.0), (100, 1)))
+    assert pf.poses[:100, 0].tolist() == [9.0] * 100
+    assert pf.weights.sum() == pytest.approx(1.0)
+    assert pf.estimate() == pytest.approx((1.0, 1.0, 0.0))
+    # The next measurement weighs them: where it favours them, the estimate follows.
+    assert pf.correct(np.where(pf.poses[:, 0] == 9.0, 100.0, 1.0))
+    assert pf.unweighed is None
+    favoured = (100 * 100 * 9.0 + 100 * 1.0) / (100 * 100 + 100)  # the upper half: 100 + 100
+    assert pf.estimate()[0] == pytest.approx(favoured)
+    # Weights from scratch (set_weights) weigh them too; resampling forgets the mark.
+    pf.redraw(np.arange(300, 400), np.tile((5.0, 5.0, 0.0), (100, 1)))
+    assert pf.estimate()[0] == pytest.approx(favoured)
+    assert pf.set_weights(np.where(pf.poses[:, 0] == 5.0, 1.0, 0.0))
+    assert pf.estimate()[0] == pytest.approx(5.0)
+    pf.redraw(np.arange(10), np.zeros((10, 3)))
+    pf.resample()
+    assert pf.unweighed is None
+    # Only unweighed particles carry weight: they are the estimate (nothing else to go by).
+    pf.poses[:] = (2.0, 2.0, 0.0)
+    pf.weights[:] = 0.0
+    pf.weights[0] = 1.0
+    pf.redraw(np.array([0]), np.array([[3.0, 3.0, 0.0]]))
+    assert pf.estimate() == pytest.approx((3.0, 3.0, 0.0))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -37,7 +38,26 @@ HIT_COUNT = "hit_count"
 #: Sensor resetting searches only when at least this share of the cloud is redrawn (the
 #: scores fell markedly): the search costs ~0.15 s of the non-RT thread on a 30 × 15 m map.
 RESET_MIN_SHARE = 0.1
+#: A kidnap episode (a redraw from the search) retries the search every SEARCH_RETRY_PERIOD
+#: s, at most SEARCH_RETRIES times, while the scores stay below (1 - SEARCH_LOST_DROP) of
+#: their level before the drop: the search missed (a lost robot's scores fall by half or more;
+#: a part of the map that fits a little worse dips them by 10-20 % and ends the episode at
+#: once, as does a found robot's).
+SEARCH_RETRY_PERIOD = 2.0
+SEARCH_RETRIES = 5
+SEARCH_LOST_DROP = 0.3
 LIKELIHOOD_FIELD = "likelihood_field"
+
+
+@dataclass
+class _KidnapEpisode:
+    """Redraws from the search since the scores fell (see :data:`SEARCH_RETRY_PERIOD`)."""
+
+    reference: float  # w_slow before the first redraw: how well the scan fitted before
+    share: float  # the first redraw's share of the cloud, also the retries'
+    last_redraw: float  # s (node clock)
+    retries: int = 0
+    retry_due: bool = False
 
 
 class CostmapAMCLLocalizer(AMCLLocalizer):
@@ -145,6 +165,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._acc_generation = -1
         self._w_slow = 0.0
         self._w_fast = 0.0
+        self._episode: _KidnapEpisode | None = None  # searches since the scores fell
         self._reset_map: Costmap2D | None = None
         self._reset_fields: tuple[np.ndarray, np.ndarray] | None = None
         self._reset_poses: np.ndarray | None = None  # ranked, best first; None: uniform redraws
@@ -165,6 +186,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._field_map = self._field = None
         self._lf_map = self._lf_field = None
         self._w_slow = self._w_fast = 0.0
+        self._episode = None
         self._reset_poses = None
         with self._lock:
             self._generation += 1
@@ -266,8 +288,8 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             weights, score = self._likelihood_field_weights(snapshot, points, base)
         else:
             weights, score = self._hit_count_weights(snapshot, points, base, generation)
-        self._track_scores(score)
         now = self.now()
+        self._track_scores(score, now)
         reseed_due = now - self._last_reseed >= self.reseed_period or now < self._last_reseed
         self._prepare_sensor_reset(base, points, weights, reseed_due)
         with self._lock:
@@ -335,7 +357,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         total = mean * inside + (len(points) - inside) * self._lf_off
         return 1.0 + total, float((total / len(points)).mean())
 
-    def _track_scores(self, score: float) -> None:
+    def _track_scores(self, score: float, now: float) -> None:
         p = self.params
         if p.recovery_alpha_slow <= 0.0 or p.recovery_alpha_fast <= 0.0:
             return
@@ -343,12 +365,23 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             self._w_slow = self._w_fast = score
         self._w_slow += p.recovery_alpha_slow * (score - self._w_slow)
         self._w_fast += p.recovery_alpha_fast * (score - self._w_fast)
+        episode = self._episode
+        if episode is None:
+            return
+        if (score >= (1.0 - SEARCH_LOST_DROP) * episode.reference
+                or episode.retries >= SEARCH_RETRIES):
+            self._episode = None  # found, or the drop was the place's, or given up
+        elif now - episode.last_redraw >= SEARCH_RETRY_PERIOD or now < episode.last_redraw:
+            episode.retry_due = True
 
     def _recovery_share(self) -> float:
-        """Augmented MCL's share of the cloud to redraw: ``1 - w_fast/w_slow`` (0 when off)."""
-        if self._w_slow <= 0.0:
-            return 0.0
-        return max(0.0, 1.0 - self._w_fast / self._w_slow)
+        """Augmented MCL's share of the cloud to redraw: ``1 - w_fast/w_slow`` (0 when off),
+        or the episode's first share when a retry of the search is due."""
+        share = 0.0 if self._w_slow <= 0.0 else max(0.0, 1.0 - self._w_fast / self._w_slow)
+        episode = self._episode
+        if episode is not None and episode.retry_due:
+            share = max(share, episode.share)
+        return share
 
     def _prepare_sensor_reset(self, base: Costmap2D, points: np.ndarray,
                               weights: np.ndarray, reseed_due: bool) -> None:
@@ -387,10 +420,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         """Weigh the cloud (lock held); in the likelihood-field model resample when the cloud
         degenerates."""
         if self.params.sensor_model == HIT_COUNT:
-            total = weights.sum()
-            if total > 0.0:
-                self.filter.weights = weights / total
-            else:
+            if not self.filter.set_weights(weights):
                 self._throttle.warn(self.logger, "no-hits",
                                     f"{self.plugin_name}: no particle's points hit the map")
             return
@@ -451,9 +481,17 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             except ValueError:
                 return False
             where = "over the free space"
-        self.filter.poses[order] = poses
-        self.filter.weights[order] = self.filter.weights.mean()
-        self.filter.weights /= self.filter.weights.sum()
+        self.filter.redraw(order, poses)
+        if ranked is not None:
+            if self._episode is None:
+                self._episode = _KidnapEpisode(
+                    reference=self._w_slow, share=share, last_redraw=self.now())
+            else:
+                self._episode.retries += 1
+                self._episode.last_redraw = self.now()
+                self._episode.retry_due = False
+        # Nav2's reset: both averages restart together at the next score, and no redraw
+        # follows until the scores fall again (the episode retries a search that missed).
         self._w_slow = self._w_fast = 0.0
         self.logger.info(f"{self.plugin_name}: {count} particles redrawn {where} "
                          f"(scores fell: kidnapped?)")
@@ -471,6 +509,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             self._generation += 1
             self.filter.replace(poses)
         self._w_slow = self._w_fast = 0.0
+        self._episode = None
         self._last_reseed = self.now()
         self.logger.info(f"{self.plugin_name}: global localisation: {count} particles over "
                          "the free space")

@@ -154,6 +154,9 @@ class ParticleFilter2D:
         self.rng = rng if rng is not None else np.random.default_rng()
         self.poses = np.zeros((num_particles, 3))
         self.weights = np.full(num_particles, 1.0 / num_particles)
+        #: Particles placed since the last measurement (:meth:`redraw`), left out of
+        #: :meth:`estimate` until a measurement weighed them; None when there are none.
+        self.unweighed: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.poses)
@@ -196,6 +199,7 @@ class ParticleFilter2D:
         self.poses[:, 1] = y + offsets[:, 1]
         self.poses[:, 2] = _wrap(yaw + max(abs(std_yaw), min_std_yaw) * self.rng.standard_normal(n))
         self.weights[:] = 1.0 / n
+        self.unweighed = None
 
     def predict(
         self,
@@ -237,7 +241,37 @@ class ParticleFilter2D:
         if not total > 0.0:
             return False
         self.weights = product / total
+        self.unweighed = None
         return True
+
+    def set_weights(self, weights: np.ndarray) -> bool:
+        """Take ``weights`` (one per particle, >= 0) as the measurement's, normalised: for
+        models that weigh from scratch rather than multiply. False (unchanged) when they sum
+        to zero."""
+        weights = np.asarray(weights, dtype=float)
+        if weights.shape != self.weights.shape:
+            raise ValueError(f"{len(weights)} weights for {len(self.weights)} particles")
+        total = weights.sum()
+        if not total > 0.0:
+            return False
+        self.weights = weights / total
+        self.unweighed = None
+        return True
+
+    def redraw(self, indices: np.ndarray, poses: np.ndarray) -> None:
+        """Put the particles ``indices`` at ``poses`` with the mean weight, and leave them out
+        of :meth:`estimate` until the next measurement: not yet weighed, at the mean weight
+        they would pull the estimate toward wherever they were drawn (recovery redraws put
+        them across the map)."""
+        indices = np.asarray(indices, dtype=int)
+        poses = np.array(poses, dtype=float).reshape(-1, 3)
+        poses[:, 2] = _wrap(poses[:, 2])
+        self.poses[indices] = poses
+        self.weights[indices] = self.weights.mean()
+        self.weights /= self.weights.sum()
+        if self.unweighed is None:
+            self.unweighed = np.zeros(len(self.poses), dtype=bool)
+        self.unweighed[indices] = True
 
     def effective_sample_size(self) -> float:
         """``1 / Σ w²``: N for uniform weights, 1 when one particle holds them all."""
@@ -256,6 +290,7 @@ class ParticleFilter2D:
         indices = np.searchsorted(cumulative, positions, side="right")
         self.poses = self.poses[np.minimum(indices, n - 1)]
         self.weights = np.full(m, 1.0 / m)
+        self.unweighed = None
 
     def replace(self, poses: np.ndarray) -> None:
         """Take ``poses`` (``(M, 3)``) as the cloud, uniform weights (global localisation)."""
@@ -265,6 +300,7 @@ class ParticleFilter2D:
         poses[:, 2] = _wrap(poses[:, 2])
         self.poses = poses
         self.weights = np.full(len(poses), 1.0 / len(poses))
+        self.unweighed = None
 
     def reseed_worst_half(self, min_noise_xy: float, min_noise_yaw: float) -> None:
         """Redraw the lower-weight half around the upper half (see the class docstring)."""
@@ -290,10 +326,16 @@ class ParticleFilter2D:
 
     # -- estimates ----------------------------------------------------------------------------
     def estimate(self) -> tuple[float, float, float]:
-        """Weighted mean of the upper-weight half (robust to stray particles), circular for yaw."""
+        """Weighted mean of the upper-weight half (robust to stray particles), circular for yaw;
+        particles not yet weighed (:attr:`unweighed`) count only when no other has weight."""
         n = len(self.poses)
-        top = np.argsort(-self.weights, kind="stable")[: max(1, n // 2)]
-        w = self.weights[top]
+        weights = self.weights
+        if self.unweighed is not None and len(self.unweighed) == n:
+            kept = np.where(self.unweighed, 0.0, weights)
+            if kept.sum() > 0.0:
+                weights = kept
+        top = np.argsort(-weights, kind="stable")[: max(1, n // 2)]
+        w = weights[top]
         w = w / w.sum() if w.sum() > 0.0 else np.full(len(top), 1.0 / len(top))
         x, y = w @ self.poses[top, :2]
         yaw = math.atan2(w @ np.sin(self.poses[top, 2]), w @ np.cos(self.poses[top, 2]))
