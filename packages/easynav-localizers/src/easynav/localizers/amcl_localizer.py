@@ -64,6 +64,15 @@ AMCL_PARAMETERS = (
 )
 
 
+def odometry_increment(
+    a: tuple[float, float, float], b: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """Planar pose ``b`` in the frame of pose ``a``: the motion from odometry ``a`` to ``b``."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return c * dx + s * dy, -s * dx + c * dy, normalize_angle(b[2] - a[2])
+
+
 def _xy_yaw(pose: Pose) -> tuple[float, float, float]:
     return pose.x, pose.y, pose.yaw
 
@@ -247,15 +256,7 @@ class AMCLLocalizer(LocalizerMethodBase):
             if new_odom:
                 current = _xy_yaw(odom.pose)
                 if self._odom_used is not None:
-                    x0, y0, yaw0 = self._odom_used
-                    c, s = math.cos(yaw0), math.sin(yaw0)
-                    dxw, dyw = current[0] - x0, current[1] - y0
-                    self.filter.predict(
-                        c * dxw + s * dyw,
-                        -s * dxw + c * dyw,
-                        normalize_angle(current[2] - yaw0),
-                        *self.noise,
-                    )
+                    self._predict(*odometry_increment(self._odom_used, current))
                 self._odom_used = current
                 self._odom_used_stamp = odom.header.stamp
             estimate = self.filter.estimate()
@@ -263,6 +264,10 @@ class AMCLLocalizer(LocalizerMethodBase):
         self._write_pose(nav_state, estimate, covariance, odom)
         if new_odom:
             self._send_map_to_odom(estimate, _xy_yaw(odom.pose), odom.header.stamp)
+
+    def _predict(self, dx: float, dy: float, dyaw: float) -> None:
+        """Move the cloud by an odometry increment (robot frame). RT thread, lock held."""
+        self.filter.predict(dx, dy, dyaw, *self.noise)
 
     # -- correction (non-RT) ------------------------------------------------------------------
     def update(self, nav_state: NavState) -> None:

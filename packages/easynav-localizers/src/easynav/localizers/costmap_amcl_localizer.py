@@ -262,19 +262,9 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
     def update(self, nav_state: NavState) -> None:
         """Global localisation if asked; weigh the particles; resample/reseed; write the pose.
         Non-RT thread."""
-        alias = self.plugin_name
-        if not nav_state.has(MAP_BASE):
-            self._throttle.warn(self.logger, "no-map", f"{alias}: no '{MAP_BASE}' costmap yet")
+        base = self._map_for_update(nav_state)
+        if base is None:
             return
-        base = nav_state.get(MAP_BASE, Costmap2D)
-        if base.width == 0 or base.height == 0:
-            self._throttle.warn(self.logger, "empty-map", f"{alias}: '{MAP_BASE}' is empty")
-            return
-        if nav_state.has(GLOBAL_LOCALIZATION_REQUEST) and nav_state.get(
-            GLOBAL_LOCALIZATION_REQUEST
-        ):
-            nav_state.set(GLOBAL_LOCALIZATION_REQUEST, False)
-            self._global_requested = True
         if self._global_requested:
             self._global_requested = False
             self._spread_globally(base)
@@ -303,6 +293,24 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             poses = self.filter.poses.copy()
         self._write_pose(nav_state, estimate, covariance, self._odom)
         self._publish_particles(poses, estimate, covariance)
+
+    def _map_for_update(self, nav_state: NavState) -> Costmap2D | None:
+        """NavState ``map.base`` (None, warned, when missing or empty); takes a global
+        localisation request from NavState (:attr:`_global_requested`). Non-RT thread."""
+        alias = self.plugin_name
+        if not nav_state.has(MAP_BASE):
+            self._throttle.warn(self.logger, "no-map", f"{alias}: no '{MAP_BASE}' costmap yet")
+            return None
+        base = nav_state.get(MAP_BASE, Costmap2D)
+        if base.width == 0 or base.height == 0:
+            self._throttle.warn(self.logger, "empty-map", f"{alias}: '{MAP_BASE}' is empty")
+            return None
+        if nav_state.has(GLOBAL_LOCALIZATION_REQUEST) and nav_state.get(
+            GLOBAL_LOCALIZATION_REQUEST
+        ):
+            nav_state.set(GLOBAL_LOCALIZATION_REQUEST, False)
+            self._global_requested = True
+        return base
 
     def _scan_points(self, nav_state: NavState, resolution: float) -> np.ndarray | None:
         perceptions = nav_state.get_no_group(PointPerception)

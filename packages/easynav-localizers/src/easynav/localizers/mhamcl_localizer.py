@@ -15,9 +15,8 @@ from easynav.core.plugins import Param, PluginConfigurationError
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, normalize_angle
-from easynav.localizers.amcl_localizer import _xy_yaw
+from easynav.localizers.amcl_localizer import odometry_increment
 from easynav.localizers.costmap_amcl_localizer import (
-    GLOBAL_LOCALIZATION_REQUEST,
     LIKELIHOOD_FIELD,
     CostmapAMCLLocalizer,
 )
@@ -34,7 +33,6 @@ from easynav.localizers.particle_filter import (
     likelihood_field,
     occupied_cells,
 )
-from easynav.maps.costmap.keys import MAP_BASE
 
 HYPOTHESES_COUNT = NavStateKey(
     "localizer.mhamcl.hypotheses", "int", "how many pose hypotheses the MH-AMCL keeps."
@@ -53,13 +51,6 @@ _ACCEPTED = "accepted for the original's files, not used here: {}"
 def _replace(params: tuple[Param, ...], *new: Param) -> tuple[Param, ...]:
     names = {p.name: p for p in new}
     return tuple(names.pop(p.name, p) for p in params) + tuple(names.values())
-
-
-def _relative(a: tuple[float, float, float], b: tuple[float, float, float]):
-    """Pose ``b`` in the frame of pose ``a`` (planar)."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    return c * dx + s * dy, -s * dx + c * dy, normalize_angle(b[2] - a[2])
 
 
 @dataclass(eq=False)
@@ -282,44 +273,19 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
                          f"({x:.3f}, {y:.3f}, {yaw:.3f})")
 
     # -- prediction (RT) ----------------------------------------------------------------------
-    def update_rt(self, nav_state: NavState) -> None:
-        """Move every hypothesis by the new odometry; write the selected one's ``robot_pose``;
-        broadcast ``map → odom`` once per odometry message. RT thread."""
-        if self.params.compute_odom_from_tf:
-            self._odometry_from_tf()
-        odom = self._odom
-        new_odom = odom is not None and odom.header.stamp != self._odom_used_stamp
-        with self._lock:
-            if new_odom:
-                current = _xy_yaw(odom.pose)
-                if self._odom_used is not None:
-                    delta = _relative(self._odom_used, current)
-                    for h in self.hypotheses:
-                        h.filter.predict(*delta, *self.noise)
-                self._odom_used = current
-                self._odom_used_stamp = odom.header.stamp
-            estimate = self.filter.estimate()
-            covariance = self.filter.covariance(estimate)
-        self._write_pose(nav_state, estimate, covariance, odom)
-        if new_odom:
-            self._send_map_to_odom(estimate, _xy_yaw(odom.pose), odom.header.stamp)
+    def _predict(self, dx: float, dy: float, dyaw: float) -> None:
+        """Move every hypothesis by an odometry increment (the base class's update_rt then
+        writes the selected one's pose and ``map → odom``). RT thread, lock held."""
+        for h in self.hypotheses:
+            h.filter.predict(dx, dy, dyaw, *self.noise)
 
     # -- correction (non-RT) ------------------------------------------------------------------
     def update(self, nav_state: NavState) -> None:
         """Weigh every hypothesis, reseed, search for new ones when due, merge, prune, select;
         write the selected one's pose. Non-RT thread."""
-        alias = self.plugin_name
-        if not nav_state.has(MAP_BASE):
-            self._throttle.warn(self.logger, "no-map", f"{alias}: no '{MAP_BASE}' costmap yet")
+        base = self._map_for_update(nav_state)
+        if base is None:
             return
-        base = nav_state.get(MAP_BASE, Costmap2D)
-        if base.width == 0 or base.height == 0:
-            self._throttle.warn(self.logger, "empty-map", f"{alias}: '{MAP_BASE}' is empty")
-            return
-        if nav_state.has(GLOBAL_LOCALIZATION_REQUEST) and nav_state.get(
-                GLOBAL_LOCALIZATION_REQUEST):
-            nav_state.set(GLOBAL_LOCALIZATION_REQUEST, False)
-            self._global_requested = True
         points = self._scan_points(nav_state, base.resolution)
         if points is None:
             return
@@ -511,7 +477,7 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
         """The candidates carried by the odometry received since the scan (lock held)."""
         if odom_at_scan is None or self._odom_used is None or not candidates:
             return candidates
-        dx, dy, dyaw = _relative(odom_at_scan, self._odom_used)
+        dx, dy, dyaw = odometry_increment(odom_at_scan, self._odom_used)
         moved = []
         for pose, quality in candidates:
             c, s = math.cos(pose[2]), math.sin(pose[2])

@@ -481,22 +481,8 @@ def main(argv: list[str] | None = None) -> int:
             print("easynav demo: with --robots the waypoints are each robot's in the world "
                   "description (leave --waypoints out)", file=sys.stderr)
             return EXIT_USAGE
-        return run_fleet_demo(
-            world=args.world or "crossing",
-            robots=args.robots,
-            params_file=args.params,
-            speed_up=args.speed_up,
-            output_png=args.output,
-            timeout=args.timeout,
-            seed=args.seed,
-            moving_obstacles=not args.no_obstacles,
-            domain_id=args.domain_id,
-            run_dir=args.run_dir,
-        )
-    return run_demo(
-        world=args.world or "home",
+    common = dict(
         params_file=args.params,
-        waypoints=args.waypoints,
         speed_up=args.speed_up,
         output_png=args.output,
         timeout=args.timeout,
@@ -505,6 +491,9 @@ def main(argv: list[str] | None = None) -> int:
         domain_id=args.domain_id,
         run_dir=args.run_dir,
     )
+    if args.robots > 1:
+        return run_fleet_demo(world=args.world or "crossing", robots=args.robots, **common)
+    return run_demo(world=args.world or "home", waypoints=args.waypoints, **common)
 
 
 def controller_cycle_from_log(log_path: Path) -> dict | None:
