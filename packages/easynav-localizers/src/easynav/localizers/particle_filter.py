@@ -236,13 +236,7 @@ class ParticleFilter2D:
                 f"{likelihoods.shape[0] if likelihoods.ndim else 0} likelihoods for "
                 f"{len(self.weights)} particles"
             )
-        product = self.weights * np.where(np.isfinite(likelihoods), likelihoods, 0.0)
-        total = product.sum()
-        if not total > 0.0:
-            return False
-        self.weights = product / total
-        self.unweighed = None
-        return True
+        return self.set_weights(self.weights * np.where(np.isfinite(likelihoods), likelihoods, 0.0))
 
     def set_weights(self, weights: np.ndarray) -> bool:
         """Take ``weights`` (one per particle, >= 0) as the measurement's, normalised: for
