@@ -27,6 +27,7 @@ from easynav.localizers.fusion.fusion_filter import (  # noqa: E402
     FusionFilter,
     attitude_in,
     pose_in,
+    robot_pose_from_child,
 )
 from easynav.localizers.fusion.fusion_input import FusionInput  # noqa: E402
 from easynav.localizers.fusion.fusion_parameters import read_inputs  # noqa: E402
@@ -308,3 +309,96 @@ def test_the_two_names_of_the_imu_twist_gate_must_agree():
     plugin = configure(**{"Ukf.global_filter.imu0_twist_rejection_threshold": 2.0,
                           "Ukf.global_filter.imu0_angular_velocity_rejection_threshold": 2.0})
     assert plugin.filters["global_filter"].inputs["imu0"].twist_threshold == 2.0
+
+
+# -- odomN_pose_use_child_frame -----------------------------------------------------------------
+#: An odometry source mounted 0.5 m ahead of the robot and turned 90° (its child frame).
+MOUNT = np.array((0.5, 0.0, 0.0, 0.0, 0.0, math.pi / 2))  # child frame in the robot frame
+ROBOT_IN_CHILD = pose_in(MOUNT, np.zeros(6))  # TF child -> robot: the robot in the child frame
+
+
+def child_pose(robot_x: float, robot_y: float, robot_yaw: float) -> np.ndarray:
+    """Where the child frame is when the robot is at ``(robot_x, robot_y, robot_yaw)``."""
+    c, s = math.cos(robot_yaw), math.sin(robot_yaw)
+    return np.array((robot_x + c * MOUNT[0] - s * MOUNT[1], robot_y + s * MOUNT[0] + c * MOUNT[1],
+                     robot_yaw + MOUNT[5]))
+
+
+def odom_filter(use_child_frame: bool) -> FusionFilter:
+    source = FusionInput("odom", 0, "odom", [True, True] + [False] * 3 + [True] + [False] * 9,
+                         pose_use_child_frame=use_child_frame)
+    ukf = UkfFilter(two_d_mode=True, initial_covariance=np.diag([1.0] * 6 + [1e-6] * 9))
+    return FusionFilter(ukf, [source])
+
+
+def child_odometry(stamp: float, x: float, y: float, yaw: float) -> Odometry:
+    return Odometry(header=Header(stamp, "odom"), child_frame_id="odom_sensor",
+                    pose=Pose.from_xy_yaw(x, y, yaw), pose_covariance=np.eye(6) * 1e-6)
+
+
+def test_robot_pose_from_child_inverts_the_mount():
+    cov = np.diag([0.04, 1e-4, 1e-6, 1e-6, 1e-6, 0.01])
+    pose, rotated = robot_pose_from_child(np.array((*child_pose(1.0, 2.0, 0.3)[:2], 0.0, 0.0,
+                                                    0.0, 0.3 + math.pi / 2)), cov,
+                                          ROBOT_IN_CHILD)
+    np.testing.assert_allclose(pose, (1.0, 2.0, 0.0, 0.0, 0.0, 0.3), atol=1e-12)
+    # The covariance turns with the mount (robot_localization: rot6dᵀ · C · rot6d): the child
+    # frame's x variance becomes the robot frame's y variance.
+    np.testing.assert_allclose(np.diag(rotated)[:2], (1e-4, 0.04), atol=1e-12)
+
+
+@pytest.mark.parametrize("use_child_frame", [True, False])
+def test_pose_use_child_frame_fuses_the_robot_pose_not_the_sensor_pose(use_child_frame):
+    """odom0 reports where its child frame (a sensor 0.5 m ahead, turned 90°) is. With
+    ``odom0_pose_use_child_frame`` the estimate is the robot's pose; without it the sensor's
+    pose is taken as the robot's (0.5 m and 90° off)."""
+    filt = odom_filter(use_child_frame)
+    for k in range(1, 6):
+        x, y, yaw = child_pose(1.0, 2.0, 0.3)
+        filt.add_odometry("odom0", child_odometry(float(k), x, y, yaw), ROBOT_IN_CHILD)
+    state = filt.ukf.state
+    expected = (1.0, 2.0, 0.3) if use_child_frame else child_pose(1.0, 2.0, 0.3)
+    np.testing.assert_allclose((state[0], state[1], state[YAW]), expected, atol=1e-3)
+
+
+def test_pose_use_child_frame_reads_the_mount_from_tf_and_is_a_known_key():
+    """The plugin: ``odom0_pose_use_child_frame`` (robot_localization's key) reaches the
+    input, and the child -> robot transform comes from EasyNav's TF buffer
+    (base_footprint -> odom_sensor, static)."""
+    from easynav.core.nav_state import NavState
+    from easynav.core.tf import get_tf_buffer
+    from easynav.core.types import Transform, TransformStamped
+
+    assert FusionLocalizer.unknown_parameter_keys(
+        {"global_filter.odom0_pose_use_child_frame": True}) == []
+    assert [k for k, _ in FusionLocalizer.unknown_parameter_keys(
+        {"global_filter.pose0_pose_use_child_frame": True})] == [
+        "global_filter.pose0_pose_use_child_frame"]  # robot_localization: odometry only
+    key = "Ukf.global_filter.odom0_pose_use_child_frame"
+    results = {}
+    for flag in (True, False):
+        namespace = f"fusion_child_frame_{flag}"
+        params = {
+            "Ukf.global_filter.two_d_mode": True, "Ukf.global_filter.publish_tf": False,
+            "Ukf.global_filter.initial_estimate_covariance": [1.0] * 6 + [1e-6] * 9,
+            "Ukf.global_filter.odom0": "odom",
+            "Ukf.global_filter.odom0_config": [True, True] + [False] * 3 + [True] + [False] * 9,
+            key: flag,
+        }
+        plugin = FusionLocalizer()
+        plugin.initialize(PluginContext(parameters=DictParameters(params), namespace=namespace),
+                          "Ukf")
+        assert plugin.filters["global_filter"].inputs["odom0"].pose_use_child_frame is flag
+        get_tf_buffer(namespace).set_transform(TransformStamped(
+            Header(0.0, "base_footprint"), "odom_sensor",
+            Transform(np.array(MOUNT[:3]), np.array(yaw_to_quaternion(MOUNT[5])))),
+            "test", is_static=True)
+        nav_state = NavState()
+        for k in range(1, 6):
+            plugin.add_odometry("global_filter", "odom0",
+                                child_odometry(float(k), *child_pose(1.0, 2.0, 0.3)))
+            plugin.update_rt(nav_state)
+        pose = nav_state.get("robot_pose", Odometry).pose
+        results[flag] = (pose.x, pose.y, pose.yaw)
+    np.testing.assert_allclose(results[True], (1.0, 2.0, 0.3), atol=1e-3)
+    np.testing.assert_allclose(results[False], child_pose(1.0, 2.0, 0.3), atol=1e-3)

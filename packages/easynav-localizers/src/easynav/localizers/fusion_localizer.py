@@ -22,7 +22,7 @@ from easynav.core.types import (
     Pose,
     Twist,
 )
-from easynav.localizers.fusion.fusion_filter import FusionFilter
+from easynav.localizers.fusion.fusion_filter import FusionFilter, quaternion_to_rpy
 from easynav.localizers.fusion.fusion_parameters import (
     FILTER_PARAMETERS,
     FILTER_PREFIXES,
@@ -274,6 +274,8 @@ class FusionLocalizer(LocalizerMethodBase):
         fixes = self._gnss_fixes(nav_state)
         now = self.now()
         outputs = {}
+        buffer = get_tf_buffer(self.context.namespace)
+        tf_info = buffer.get_tf_info()
         with self._lock:
             for prefix, filt in self.filters.items():
                 events = []
@@ -294,7 +296,9 @@ class FusionLocalizer(LocalizerMethodBase):
                 for _, name, value in events:
                     try:
                         if isinstance(value, Odometry):
-                            filt.add_odometry(name, value)
+                            filt.add_odometry(name, value, self._robot_in_child(
+                                buffer, tf_info.robot_footprint_frame, filt.inputs[name],
+                                value))
                         elif isinstance(value, ImuPerception):
                             filt.add_imu(name, value, self._gravity[prefix])
                         elif not filt.add_gnss(name, value) and value.has_fix:
@@ -310,7 +314,6 @@ class FusionLocalizer(LocalizerMethodBase):
                     filt.predict_to(now)
                 if filt.initialized and filt.time is not None:
                     outputs[prefix] = (filt.ukf.state, filt.ukf.covariance, filt.time)
-        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
         for prefix, (state, cov, stamp) in outputs.items():
             frame = tf_info.map_frame if prefix == "global_filter" else tf_info.odom_frame
             odometry = self._odometry(state, cov, stamp, frame, tf_info.robot_footprint_frame)
@@ -320,6 +323,28 @@ class FusionLocalizer(LocalizerMethodBase):
         if self._publish_tf and "global_filter" in outputs:
             state, _, stamp = outputs["global_filter"]
             self._send_map_to_odom(state, stamp)
+
+    def _robot_in_child(self, buffer, robot_frame: str, source, odometry: Odometry):
+        """For an ``odomN`` with ``_pose_use_child_frame`` whose child frame is not the robot
+        frame: the robot frame's pose in the child frame (TF ``child → robot`` at the
+        message's stamp, else the latest, as robot_localization's lookupTransformSafe);
+        None otherwise or when TF has no such transform (the pose is then taken as the
+        robot's, as the original does, with a throttled warning)."""
+        child = odometry.child_frame_id.lstrip("/")
+        if not source.pose_use_child_frame or not child or child == robot_frame.lstrip("/"):
+            return None
+        for stamp in (odometry.header.stamp, None):
+            try:
+                _, (x, y, z, qx, qy, qz, qw) = buffer.lookup_transform_values(
+                    child, robot_frame, stamp)
+            except LookupError:
+                continue
+            return np.array((x, y, z, *quaternion_to_rpy(qx, qy, qz, qw)))
+        self._throttle.warn(
+            self.logger, f"{source.name}-child-frame",
+            f"{self.plugin_name}: {source.name}_pose_use_child_frame: no transform "
+            f"{child} → {robot_frame}: the pose is used as the robot's")
+        return None
 
     def _gnss_fixes(self, nav_state: NavState) -> dict[str, GNSSPerception]:
         # gpsN is the N-th member (in the group's order) holding a GNSSPerception.

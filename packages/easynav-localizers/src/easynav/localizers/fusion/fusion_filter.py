@@ -56,6 +56,24 @@ def pose_in(reference: np.ndarray, pose: np.ndarray) -> np.ndarray:
     return out
 
 
+def robot_pose_from_child(pose: np.ndarray, covariance: np.ndarray,
+                          robot_in_child: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The robot's pose and pose covariance from the pose of a frame mounted on it
+    (``odomN_pose_use_child_frame``, robot_localization's ``pose * source_frame_trans``):
+    ``pose`` (x, y, z, roll, pitch, yaw) is the child frame's, ``robot_in_child`` the robot
+    frame's pose in the child frame (TF ``child → robot``); the 6×6 ``covariance`` is rotated
+    by that transform's rotation (both blocks), as the original does."""
+    r_child = rotation_rpy(*pose[3:6])
+    r_mount = rotation_rpy(*robot_in_child[3:6])
+    out = np.empty(6)
+    out[:3] = pose[:3] + r_child @ robot_in_child[:3]
+    out[3:6] = rpy_of_rotation(r_child @ r_mount)
+    rot6 = np.zeros((6, 6))
+    rot6[:3, :3] = r_mount
+    rot6[3:, 3:] = r_mount
+    return out, rot6.T @ np.asarray(covariance, dtype=float).reshape(6, 6) @ rot6
+
+
 def attitude_in(reference: np.ndarray, rpy: np.ndarray) -> np.ndarray:
     """Roll, pitch, yaw ``rpy`` relative to the attitude ``reference``."""
     return rpy_of_rotation(rotation_rpy(*reference).T @ rotation_rpy(*rpy))
@@ -119,8 +137,15 @@ class FusionFilter:
             self.time = stamp
 
     # -- measurements --------------------------------------------------------------------------
-    def add_odometry(self, name: str, odometry: Odometry) -> None:
-        """An ``odomN`` (pose and twist) or ``poseN`` (pose only) or ``twistN`` message."""
+    def add_odometry(self, name: str, odometry: Odometry,
+                     robot_in_child: np.ndarray | None = None) -> None:
+        """An ``odomN`` (pose and twist) or ``poseN`` (pose only) or ``twistN`` message.
+
+        ``robot_in_child``: for an ``odomN`` with ``_pose_use_child_frame``, the robot frame's
+        pose (x, y, z, roll, pitch, yaw) in the message's child frame (TF ``child → robot``):
+        the pose is the child frame's and becomes the robot's before it is fused (None: the
+        pose is the robot's, as when the child frame is the robot frame or TF lacks it).
+        """
         source = self.inputs[name]
         stamp = odometry.header.stamp
         p = odometry.pose
@@ -128,9 +153,13 @@ class FusionFilter:
         twist = np.array(odometry.twist.as_tuple())
         if not (np.all(np.isfinite(pose)) and np.all(np.isfinite(twist))):
             raise ValueError(f"{name}: non-finite odometry")
+        pose_cov = np.asarray(odometry.pose_covariance, float)
+        if robot_in_child is not None and source.kind == "odom" and source.pose_use_child_frame:
+            pose, pose_cov = robot_pose_from_child(pose, pose_cov,
+                                                   np.asarray(robot_in_child, dtype=float))
         self._begin(stamp)
         if source.kind in ("odom", "pose"):
-            self._fuse_pose(source, stamp, pose, np.asarray(odometry.pose_covariance, float))
+            self._fuse_pose(source, stamp, pose, pose_cov)
         if source.kind in ("odom", "twist"):
             idx = source.enabled(VX, VYAW)
             if idx:

@@ -20,10 +20,12 @@ class FusionInput:
 
     ``config`` (``_config``): which of the 15 state variables the input measures.
     ``differential``: pose values are differentiated into velocities; ``relative``: pose values
-    are taken relative to the input's first message. Thresholds are Mahalanobis distances
-    (``inf``: no gate): ``pose_threshold`` gates the pose part (an IMU's orientation, a GNSS
-    position), ``twist_threshold`` the twist part (an IMU's angular velocity),
-    ``acceleration_threshold`` an IMU's linear acceleration.
+    are taken relative to the input's first message; ``pose_use_child_frame`` (``odomN`` only):
+    the pose is that of the message's ``child_frame_id``, not of the robot, and is moved to the
+    robot frame by the ``child → robot`` transform before anything else. Thresholds are
+    Mahalanobis distances (``inf``: no gate): ``pose_threshold`` gates the pose part (an
+    IMU's orientation, a GNSS position), ``twist_threshold`` the twist part (an IMU's angular
+    velocity), ``acceleration_threshold`` an IMU's linear acceleration.
 
     Thread contract: a plain value, built at configure time and then only read.
     """
@@ -34,6 +36,7 @@ class FusionInput:
     config: list[bool] = field(default_factory=_no_config)
     differential: bool = False
     relative: bool = False
+    pose_use_child_frame: bool = False
     queue_size: int = 10
     pose_threshold: float = math.inf
     twist_threshold: float = math.inf

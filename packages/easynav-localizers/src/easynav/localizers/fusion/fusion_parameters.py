@@ -85,6 +85,9 @@ def _input_suffixes(kind: str) -> tuple[Param, ...]:
     )
     if kind == "odom":
         return common + pose_like + (
+            Param("_pose_use_child_frame", False, "the pose is of the message's child_frame_id: "
+                  "moved to the robot frame through TF (child → robot) before it is fused",
+                  **_STATIC),
             Param("_pose_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),
             Param("_twist_rejection_threshold", NO_THRESHOLD, _THRESHOLD_DOC, gt=0.0),
         )
@@ -156,6 +159,8 @@ def read_inputs(access: Any, prefix: str, warn: Any = None) -> list[FusionInput]
                     warn(f"{prefix}.{name}_differential and {prefix}.{name}_relative are both "
                          "true: differential is used")
                 source.relative = False
+            if kind == "odom":
+                source.pose_use_child_frame = values[name + "_pose_use_child_frame"]
             if kind in ("odom", "imu"):
                 source.pose_threshold = values[name + "_pose_rejection_threshold"]
             if kind == "odom":
