@@ -21,8 +21,8 @@ COLISION_CHECKER_PARAMETERS = (
     Param("colision_checker.active", False,
           "check each controller command against the point perceptions; zero it on a collision"),
     Param("colision_checker.debug_markers", False,
-          "accepted for compatibility; markers are not published (visualization_msgs is not "
-          "part of this installation)"),
+          "publish each check's box and points on collision_area (visualization_msgs/"
+          "MarkerArray), red on a collision"),
     Param("colision_checker.robot_radius", 0.35, "radius of the robot's circle", "m", gt=0.0),
     Param("colision_checker.robot_height", 0.5, "points above this height are ignored", "m",
           gt=0.0),

@@ -7,6 +7,7 @@ import time
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
 from geometry_msgs.msg import Twist as TwistMsg
 from geometry_msgs.msg import TwistStamped as TwistStampedMsg
 from rclpy.duration import Duration
@@ -40,6 +41,12 @@ from easynav.core.system.node_declarations import CONTROLLER_NODE_PARAMETERS
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
 from easynav.core.velocity import VelocityOutput
 
+#: Topic of the colision_checker's debug markers (relative: controller_node's namespace, as the
+#: original's ControllerMethodBase publisher).
+COLLISION_MARKERS_TOPIC = "collision_area"
+#: Lifetime of those markers (s): not renewed (no check), they vanish, as the original's.
+COLLISION_MARKER_LIFETIME = 0.2
+
 # Former per-controller limit parameters (``<alias>.max_linear_speed``...), declared by the
 # controllers that had them, and the robot_limits field each one stands for.
 DEPRECATED_LIMIT_PARAMETERS = {
@@ -57,7 +64,9 @@ class ControllerNode(ComponentNode):
     Parameters: ``controller_types``, ``<alias>.*``, ``robot_limits.*``, ``cmd_timeout`` (0.5 s),
     ``cmd_vel_keepalive_period`` (0.0 s), ``use_cmd_vel_stamped`` (false), ``colision_checker.*``
     (with ``colision_checker.active``, each new controller command is checked by
-    :class:`ColisionChecker` against every point perception and zeroed on a collision).
+    :class:`ColisionChecker` against every point perception and zeroed on a collision; with
+    ``colision_checker.debug_markers`` too, each check publishes the original's markers on
+    ``collision_area``: see :meth:`check_collision`).
 
     Thread contract: ``cycle_rt``/``publish_cycle`` in the RT thread; ``brake`` in the thread that
     deactivates or shuts down, while the RT loop no longer cycles.
@@ -80,6 +89,8 @@ class ControllerNode(ComponentNode):
         self.published_any = False
         self.last_publish_monotonic: float | None = None
         self.colision_checker: ColisionChecker | None = None
+        self.collision_marker_publisher = None
+        self._marker_publisher = None
         system.robot_limits = self.limits_in_force
 
     # -- configuration --------------------------------------------------------------------------
@@ -96,10 +107,6 @@ class ControllerNode(ComponentNode):
         self.use_stamped = stamped
         self._check_limits()
         self._configure_colision_checker()
-        if values["colision_checker.debug_markers"]:
-            self.get_logger().warning(
-                "colision_checker.debug_markers: markers are not published in this version"
-            )
 
     def _check_limits(self) -> None:
         errors = self.robot_limits.validation_errors(f"{self.get_name()}.robot_limits.")
@@ -112,6 +119,35 @@ class ControllerNode(ComponentNode):
         self.colision_checker = (
             ColisionChecker.from_parameters(values) if values["colision_checker.active"] else None
         )
+        self._configure_collision_markers(bool(values["colision_checker.debug_markers"]))
+
+    def _configure_collision_markers(self, wanted: bool) -> None:
+        # collision_marker_publisher is the publisher of collision_area while
+        # colision_checker.debug_markers is true, else None. Switched off at runtime (parameter
+        # thread, while the RT thread may be publishing) the publisher is only set aside; it is
+        # destroyed at cleanup, when the RT loop no longer checks.
+        if not wanted:
+            self.collision_marker_publisher = None
+            return
+        if self._marker_publisher is None:
+            try:
+                from visualization_msgs.msg import MarkerArray
+            except ImportError:
+                self.get_logger().warning(
+                    "colision_checker.debug_markers: visualization_msgs is not installed: "
+                    "no markers"
+                )
+                return
+            self._marker_publisher = self.create_publisher(
+                MarkerArray, COLLISION_MARKERS_TOPIC, 10
+            )
+        self.collision_marker_publisher = self._marker_publisher
+
+    def _destroy_collision_markers(self) -> None:
+        self.collision_marker_publisher = None
+        publisher, self._marker_publisher = self._marker_publisher, None
+        if publisher is not None:
+            self.destroy_publisher(publisher)
 
     def check_node_parameter(self, name: str, value: Any) -> None:
         if name == "cmd_timeout":
@@ -219,6 +255,7 @@ class ControllerNode(ComponentNode):
 
     def cleanup_node(self) -> None:
         self.velocity_output = None
+        self._destroy_collision_markers()
         # The publisher is kept: braking to zero after a cleanup must still reach the driver.
 
     # -- robot limits -----------------------------------------------------------------------------
@@ -248,19 +285,25 @@ class ControllerNode(ComponentNode):
         """Zero the controller's command when it runs into a point (``colision_checker``).
 
         Every point perception (grouped or not, as the original) within 2 m, fused to the
-        robot frame and downsampled. RT thread.
+        robot frame and downsampled. With ``colision_checker.debug_markers``, every check that
+        has point perceptions to look at (also at a zero linear speed, as the original's)
+        publishes on ``collision_area`` the original's markers: the checked box and the points
+        in it, red on a collision, green otherwise (:func:`collision_markers`). RT thread.
         """
         checker = self.colision_checker
         if checker is None or not self.nav_state.has(CMD_VEL):
             return
         command = self.nav_state.get(CMD_VEL)
         twist = command.twist
-        if twist.vx == 0.0:
+        publisher = self.collision_marker_publisher
+        if twist.vx == 0.0 and publisher is None:
+            return
+        perceptions = self.nav_state.get_by_type(PointPerception)
+        if not perceptions:
             return
         frame = self.robot_frame()
         points = (
-            PointPerceptionsOps(self.nav_state.get_by_type(PointPerception),
-                                logger=self.get_logger())
+            PointPerceptionsOps(perceptions, logger=self.get_logger())
             .fuse(frame)
             .filter((-SEARCH_RANGE, -SEARCH_RANGE, math.nan),
                     (SEARCH_RANGE, SEARCH_RANGE, math.nan))
@@ -268,6 +311,12 @@ class ControllerNode(ComponentNode):
             .as_points()
         )
         collision = checker.check(points, twist.vx, twist.wz)
+        if publisher is not None:
+            lower, upper = checker.box(twist.vx)
+            pts = np.asarray(points, dtype=float).reshape(-1, 3)
+            inside = pts[np.all((pts >= lower) & (pts <= upper), axis=1)]
+            publisher.publish(collision_markers(
+                frame, self.now_seconds(), lower, upper, inside, collision is not None))
         if collision is None:
             return
         self.get_logger().warning(
@@ -359,3 +408,55 @@ class ControllerNode(ComponentNode):
         self.active = False
         self.brake()
         return super().on_deactivate(state)
+
+
+def collision_markers(
+    frame: str,
+    stamp: float,
+    lower: tuple[float, float, float],
+    upper: tuple[float, float, float],
+    points: np.ndarray,
+    imminent: bool,
+) -> Any:
+    """The original ControllerMethodBase's collision markers: a visualization_msgs/MarkerArray
+    in ``frame`` (namespace ``collision_zone``) with a DELETEALL (id 0), the box ``lower`` –
+    ``upper`` (CUBE, id 1) and the ``points`` (N, 3) in it (SPHERE_LIST of 0.03 m, id 2), red on
+    an ``imminent`` collision, green otherwise, alpha 0.25, lifetime 0.2 s. Needs
+    visualization_msgs (ImportError otherwise)."""
+    from geometry_msgs.msg import Point
+    from visualization_msgs.msg import Marker, MarkerArray
+
+    from easynav.core.ros.converters import time_to_msg
+
+    stamp_msg = time_to_msg(stamp)
+    colour = (1.0, 0.0, 0.0, 0.25) if imminent else (0.0, 1.0, 0.0, 0.25)
+    lifetime = divmod(int(COLLISION_MARKER_LIFETIME * 1e9), 1_000_000_000)
+
+    def marker(marker_id: int, kind: int, action: int) -> Marker:
+        m = Marker()
+        m.header.frame_id = frame
+        m.header.stamp = stamp_msg
+        m.ns = "collision_zone"
+        m.id = marker_id
+        m.type = kind
+        m.action = action
+        m.pose.orientation.w = 1.0
+        return m
+
+    array = MarkerArray()
+    array.markers.append(marker(0, Marker.ARROW, Marker.DELETEALL))
+    box = marker(1, Marker.CUBE, Marker.ADD)
+    (x0, y0, z0), (x1, y1, z1) = lower, upper
+    box.pose.position.x, box.pose.position.y = (x0 + x1) / 2.0, (y0 + y1) / 2.0
+    box.pose.position.z = (z0 + z1) / 2.0
+    box.scale.x, box.scale.y, box.scale.z = x1 - x0, y1 - y0, max(z1 - z0, 0.0)
+    sphere_list = marker(2, Marker.SPHERE_LIST, Marker.ADD)
+    sphere_list.scale.x = sphere_list.scale.y = sphere_list.scale.z = 0.03
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    finite = pts[np.all(np.isfinite(pts), axis=1)]
+    sphere_list.points = [Point(x=float(x), y=float(y), z=float(z)) for x, y, z in finite]
+    for m in (box, sphere_list):
+        m.color.r, m.color.g, m.color.b, m.color.a = colour
+        m.lifetime.sec, m.lifetime.nanosec = lifetime
+    array.markers.extend((box, sphere_list))
+    return array
