@@ -196,3 +196,70 @@ def test_smoothing_keeps_the_ends_and_straight_lines():
     smoothed = smooth_path(corner)
     assert smoothed[0] == pytest.approx([0, 0]) and smoothed[-1] == pytest.approx([2, 2])
     assert smoothed[2] == pytest.approx([1.4, 0.6])  # the corner is cut
+
+
+def pillar_room() -> Costmap2D:
+    """2 x 2 m at 0.05 m with a lethal 0.4 m pillar in the middle: from one corner to the
+    opposite one the two detours around the pillar cost the same."""
+    data = np.zeros((40, 40), dtype=np.uint8)
+    data[16:24, 16:24] = 254
+    return Costmap2D(data, 0.05, 0.0, 0.0, "map", 4.5)
+
+
+def side_of_pillar(path: Path) -> str:
+    """Which detour a path takes: above or below the diagonal through the pillar."""
+    points = xy(path)
+    middle = points[np.argmin(np.hypot(points[:, 0] - 1.0, points[:, 1] - 1.0))]
+    return "above" if middle[1] > middle[0] else "below"
+
+
+def one_side(costmap: Costmap2D, side: str) -> np.ndarray:
+    """The free cells strictly above or below the diagonal."""
+    rows, cols = np.indices(costmap.data.shape)
+    return ((rows > cols) if side == "above" else (rows < cols)) & (costmap.data == 0)
+
+
+def sides_while_the_robot_wobbles(hysteresis: float) -> list[str]:
+    """The detour planned at each step of a robot that wobbles by a cell across the diagonal
+    near the start corner (as a controller does when it hesitates between two routes)."""
+    planner = make_planner({"replan_hysteresis": hysteresis})
+    sides = []
+    for dx, dy in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 2), (3, 1), (2, 3)):
+        robot = (0.225 + 0.05 * dx, 0.225 + 0.05 * dy)
+        nav_state = state_with((1.775, 1.775, 0.0), robot_xy=robot, costmap=pillar_room())
+        planner.update(nav_state)
+        sides.append(side_of_pillar(nav_state.get("path", Path)))
+    return sides
+
+
+def test_the_cheapest_path_every_cycle_flips_between_equal_detours():
+    # The original's behaviour (replan_hysteresis 0): a one-cell wobble flips the route.
+    assert len(set(sides_while_the_robot_wobbles(0.0))) == 2
+
+
+def test_the_previous_route_is_kept_while_it_costs_about_the_same():
+    sides = sides_while_the_robot_wobbles(0.1)  # the default
+    assert len(set(sides)) == 1
+    planner = make_planner()
+    assert planner.params.replan_hysteresis == pytest.approx(0.1)
+
+
+def test_the_previous_route_gives_way_when_blocked_or_much_dearer():
+    planner = make_planner()
+    robot = (0.225, 0.225)
+    nav_state = state_with((1.775, 1.775, 0.0), robot_xy=robot, costmap=pillar_room())
+    planner.update(nav_state)
+    first = side_of_pillar(nav_state.get("path", Path))
+    # Graded cost (not blocking) over the first detour: dearer by far more than 10 %.
+    dear = pillar_room()
+    dear.data[one_side(dear, first)] = 200
+    nav_state = state_with((1.775, 1.775, 0.0), robot_xy=robot, costmap=dear)
+    planner.update(nav_state)
+    second = side_of_pillar(nav_state.get("path", Path))
+    assert second != first
+    # Now block the second detour: the route switches back although it was kept before.
+    blocked = pillar_room()
+    blocked.data[one_side(blocked, second)] = 254
+    nav_state = state_with((1.775, 1.775, 0.0), robot_xy=robot, costmap=blocked)
+    planner.update(nav_state)
+    assert side_of_pillar(nav_state.get("path", Path)) == first

@@ -9,12 +9,20 @@ from easynav.core.nav_state_keys import GOALS, ROBOT_POSE
 from easynav.core.plugins import Param
 from easynav.core.types import Costmap2D, Header, Odometry, Path
 from easynav.maps.costmap.keys import MAP, MAP_BASE, MAP_TIME
-from easynav.planners.costmap_astar import BLOCKED_COST, astar_costmap, compiled_available
+from easynav.planners.costmap_astar import (
+    BLOCKED_COST,
+    astar_costmap,
+    compiled_available,
+    path_cost,
+)
 from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, PathPlannerBase
 
 __all__ = ["DIAGNOSTIC_NAME", "HARDWARE_ID", "CostmapPlanner", "smooth_path"]
 #: Width of the moving average that smooths the cell path (the original's 5 points).
 SMOOTHING_WINDOW = 5
+#: Farthest the robot may be from the previous route for that route to be kept (m): farther,
+#: the robot has left it and the new cheapest path is taken.
+MAX_ROUTE_GAP = 0.5
 
 
 def smooth_path(points: np.ndarray, window: int = SMOOTHING_WINDOW) -> np.ndarray:
@@ -57,6 +65,14 @@ class CostmapPlanner(PathPlannerBase):
     the same and none of its cells is blocked in the current map (the original replanned unless
     the start cell and goal were unchanged and the plan younger than 0.05 s).
 
+    ``replan_hysteresis`` (beyond the original, 0.1): when replanning, the previous route (from
+    the cell nearest the robot on, joined to the robot by a straight run of cells) is kept
+    while it is open and costs at most ``1 + replan_hysteresis`` times the new cheapest path.
+    Where two routes cost the same (a pillar between two equal detours), the original's
+    cheapest-every-cycle path flips between them as the robot moves by a cell; a controller
+    following it steers between the two, towards the obstacle that separates them. 0 gives
+    the original's behaviour.
+
     ROS (when hosted by a node): publishes ``<fqn>/<alias>/path`` (nav_msgs/Path) while
     subscribed.
 
@@ -80,6 +96,13 @@ class CostmapPlanner(PathPlannerBase):
             gt=0.0,
         ),
         Param("continuous_replan", True, "plan every cycle (false: only on a new goal or block)"),
+        Param(
+            "replan_hysteresis",
+            0.1,
+            "keep the previous route while it costs at most (1 + this) times the new cheapest "
+            "one (0: always the cheapest, as the original)",
+            ge=0.0,
+        ),
     )
     READS = (GOALS, ROBOT_POSE, MAP, MAP_BASE, MAP_TIME)
     NEEDS_MAPS = ("costmap",)
@@ -89,6 +112,7 @@ class CostmapPlanner(PathPlannerBase):
         self._last_goal: tuple[float, float, float] | None = None
         self._last_cells: np.ndarray | None = None
         self._last_path: Path | None = None
+        self._last_grid: tuple | None = None  # the costmap geometry _last_cells refer to
 
     def configure_planner(self) -> None:
         """Warn when A* cannot be compiled."""
@@ -100,7 +124,7 @@ class CostmapPlanner(PathPlannerBase):
 
     def forget_path(self) -> None:
         """The kept path (``continuous_replan`` false) is no longer the answer."""
-        self._last_goal = self._last_cells = self._last_path = None
+        self._last_goal = self._last_cells = self._last_path = self._last_grid = None
 
     # -- update -------------------------------------------------------------------------------
     def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,
@@ -141,7 +165,7 @@ class CostmapPlanner(PathPlannerBase):
                     254: "on an obstacle (cost 254)", 255: "on unknown space (cost 255)"}
             self.fail(nav_state, map_frame, f"{goal_text} is {what[goal_cost]} in the costmap")
             return
-        cells, _ = astar_costmap(
+        cells, cost = astar_costmap(
             costmap.data, (six, siy), (gix, giy),
             self.params.cost_factor, self.params.heuristic_scale,
         )
@@ -149,11 +173,18 @@ class CostmapPlanner(PathPlannerBase):
             self.fail(nav_state, map_frame, f"no route from ({robot.pose.x:.2f}, "
                       f"{robot.pose.y:.2f}) to {goal_text}: blocked in the costmap")
             return
+        grid = self._grid(costmap)
+        previous = self._previous_route(costmap, grid, (six, siy), goal)
+        if previous is not None:
+            limit = (1.0 + self.params.replan_hysteresis) * cost
+            if path_cost(costmap.data, previous, self.params.cost_factor) <= limit:
+                cells = previous
         stamp = (
             float(nav_state.get(MAP_TIME)) if nav_state.has(MAP_TIME) else float(costmap.stamp)
         )
         path = Path.from_xy_yaw(self._poses(costmap, cells, goal), Header(stamp, map_frame))
         self._last_goal, self._last_cells, self._last_path = goal, cells, path
+        self._last_grid = grid
         self.write_path(nav_state, path, self._ok_message(goal_text, path))
 
     @staticmethod
@@ -171,6 +202,33 @@ class CostmapPlanner(PathPlannerBase):
         yaw[:-1] = np.arctan2(d[:, 1], d[:, 0])
         yaw[-1] = goal[2]
         return np.column_stack((xy, yaw))
+
+    @staticmethod
+    def _grid(costmap: Costmap2D) -> tuple:
+        return (costmap.resolution, costmap.origin_x, costmap.origin_y,
+                costmap.width, costmap.height)
+
+    def _previous_route(self, costmap: Costmap2D, grid: tuple, start: tuple[int, int],
+                        goal) -> np.ndarray | None:
+        """The previous route for the same goal on the same grid, from ``start`` on: a straight
+        run of cells to the route's cell nearest ``start``, then the route. None when there is
+        none to keep (hysteresis 0, another goal or grid, the robot too far from it)."""
+        if (self.params.replan_hysteresis <= 0.0 or self._last_cells is None
+                or self._last_goal != goal or self._last_grid != grid):
+            return None
+        route = self._last_cells[1:]
+        if len(route) == 0:
+            return None
+        gaps = np.abs(route - np.asarray(start)).max(axis=1)  # king moves to each cell
+        nearest = int(np.argmin(gaps))
+        gap = int(gaps[nearest])
+        if gap * costmap.resolution > MAX_ROUTE_GAP:
+            return None
+        # The straight run: king moves from start to route[nearest], both ends included.
+        steps = np.arange(gap + 1)[:, None]
+        delta = route[nearest] - np.asarray(start)
+        joint = np.asarray(start) + np.rint(steps * delta / max(gap, 1)).astype(np.int64)
+        return np.vstack((joint, route[nearest + 1:]))
 
     def _can_keep(self, costmap: Costmap2D, goal) -> bool:
         if self._last_path is None or self._last_goal != goal or self._last_cells is None:
