@@ -86,9 +86,23 @@ def test_solution_moves_towards_the_goal_within_bounds(solver):
 def test_local_target_is_horizon_points_ahead_of_the_robot():
     path = straight_path()  # 0.05 m spacing
     target = local_target(path[:, :2], (1.02, 0.1), 5)
-    # First point not farther from the goal than the robot: x = 1.05; target = 4 points later.
+    # Nearest point x = 1.00, passed by the robot: start at x = 1.05; target = 4 points later.
     assert target == pytest.approx([1.25, 0.0])
+    assert local_target(path[:, :2], (0.98, 0.1), 5) == pytest.approx([1.20, 0.0])
     assert local_target(path[:, :2], (2.99, 0.0), 5) == pytest.approx([3.0, 0.0])
+
+
+def test_local_target_follows_a_detour_that_leads_away_from_the_goal():
+    # Around an obstacle: 1 m south, 1 m east, 2 m north to the goal (1, 1). The original's
+    # "first point not farther from the goal than the robot" lies on the way north, beyond the
+    # obstacle; the target must stay on the way south, just ahead of the robot.
+    s = np.arange(0.0, 1.0, 0.05)
+    south = np.column_stack((np.zeros_like(s), -s))
+    east = np.column_stack((s, np.full_like(s, -1.0)))
+    north = np.column_stack((np.ones(41), np.linspace(-1.0, 1.0, 41)))
+    path = np.vstack((south, east, north))
+    target = local_target(path, (0.02, -0.12), 5)
+    assert target == pytest.approx([0.0, -0.35])
 
 
 @pytest.mark.parametrize("chained", [False, True])

@@ -28,14 +28,22 @@ ALIGN_GAIN = 1.0
 
 
 def local_target(path_xy: np.ndarray, position: tuple[float, float], horizon: int) -> np.ndarray:
-    """The original's target: the local path is the robot's position followed by the path from
-    its first point not farther from the goal than the robot; the target is its point
-    ``min(horizon, len - 1)``."""
-    goal = path_xy[-1]
-    d_robot = math.hypot(goal[0] - position[0], goal[1] - position[1])
-    d_points = np.hypot(goal[0] - path_xy[:, 0], goal[1] - path_xy[:, 1])
-    closer = np.flatnonzero(d_points <= d_robot)
-    start = int(closer[0]) if closer.size else 0
+    """The target: the path point ``horizon - 1`` points after the local path's start.
+
+    The local path starts at the path point nearest the robot, or the next one when the robot
+    has passed it (it lies behind the robot along the path). The original started at the first
+    point not farther from the goal (straight line) than the robot: where the path bends away
+    from the goal around an obstacle, that skipped the bend and aimed across the obstacle, and
+    every corner the robot cut moved that target farther on (the robot hit a pillar it was
+    planned around). On a path heading to the goal both choose the same point.
+    """
+    px = path_xy[:, 0] - position[0]
+    py = path_xy[:, 1] - position[1]
+    start = int(np.argmin(px * px + py * py))
+    if start + 1 < len(path_xy):
+        along = path_xy[start + 1] - path_xy[start]
+        if along[0] * -px[start] + along[1] * -py[start] > 0.0:  # the robot is past it
+            start += 1
     # Local path: [robot, path[start], ..., path[-1]]; index k >= 1 is path[start + k - 1].
     length = 1 + (len(path_xy) - start)
     index = min(horizon, length - 1)
