@@ -12,6 +12,7 @@ import yaml
 from easynav.playground.robot_description import RobotDescription
 from easynav.playground.sim.box_obstacle import BoxObstacle
 from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.multilevel import MultiLevelWorld
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.terrain import Terrain
 from easynav.playground.sim.world import World
@@ -64,6 +65,9 @@ class WorldDescription:
         terrain:                       # optional: ground heights (flat without the key)
           elevation: maps/uneven_terrain.yaml  # a gridmap file (GridmapMapsManager's formats)
           max_climb_slope_deg: 30.0    # the robot cannot climb steeper ground (Terrain)
+        levels: {floors: [...], ramps: [...], solids: [...], ...}  # optional: a multi-level
+                                       # world (MultiLevelWorld; `map` is then a 2D map of its
+                                       # ground floor for the tools, not the simulation's walls)
         robots:                        # optional: several robots (`--robots N` takes the first
           - name: r1                   # N); each its namespace, tf_prefix, start and waypoints
             start_pose: [1.0, 1.0, 0.0]
@@ -87,6 +91,18 @@ class WorldDescription:
     terrain_path: Path | None = None
     max_climb_slope_deg: float = 30.0
     robots: list[RobotEntry] = field(default_factory=list)
+    levels: dict | None = None
+
+    def make_levels(self, robot_height: float | None = None,
+                    laser_height: float = 0.25) -> MultiLevelWorld | None:
+        """The world's :class:`MultiLevelWorld` (its ``levels`` section) for a robot of
+        ``robot_height`` (default: the world's robot) with its laser at ``laser_height``; None
+        for a world without levels."""
+        if self.levels is None:
+            return None
+        height = robot_height if robot_height is not None else (self.robot.height or 0.5)
+        return MultiLevelWorld.from_dict(self.levels, f"{self.source}: levels", float(height),
+                                         float(laser_height), name=self.world.name)
 
     def fleet(self, count: int) -> list[RobotEntry]:
         """The first ``count`` robots of :attr:`robots` (a multi-robot run).
@@ -223,7 +239,7 @@ class WorldDescription:
             raise ValueError(f"{path}: a world description needs a 'map' key")
         unknown = set(data) - {
             "map", "start_pose", "waypoints", "moving_obstacles", "robot", "furniture",
-            "geodetic_origin", "imu", "gnss", "terrain", "robots",
+            "geodetic_origin", "imu", "gnss", "terrain", "robots", "levels",
         }
         if unknown:
             raise ValueError(f"{path}: unknown keys {sorted(unknown)}")
@@ -283,6 +299,11 @@ class WorldDescription:
                 raise ValueError(f"{path}: terrain.max_climb_slope_deg must be in (0, 90) deg, "
                                  f"got {climb!r}")
         robots = _robot_entries(data.get("robots"), path)
+        levels = data.get("levels")
+        if levels is not None:
+            if terrain is not None:
+                raise ValueError(f"{path}: a world has a terrain or levels, not both")
+            MultiLevelWorld.from_dict(levels, f"{path}: levels")  # ValueError: malformed
         return cls(
             world,
             map_path=map_path,
@@ -298,6 +319,7 @@ class WorldDescription:
             terrain_path=terrain_path,
             max_climb_slope_deg=float(climb),
             robots=robots,
+            levels=levels,
         )
 
 

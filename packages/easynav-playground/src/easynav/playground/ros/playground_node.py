@@ -197,6 +197,9 @@ class PlaygroundNode(Node):
             self.terrain = Terrain.load(
                 self.description.terrain_path, float(p("terrain.max_climb_slope_deg"))
             )
+        # Multi-level worlds: floors and ramps (what each level hits and sees depends on the
+        # robot's height and its laser's).
+        self.levels = self.description.make_levels(float(p("robot_height")), float(p("laser.z")))
         obstacles = self.description.make_obstacles() if p("moving_obstacles") else []
         simulations = [
             self._make_simulation(pose, rngs[5 * i:5 * i + 5], obstacles if count == 1 else [])
@@ -294,6 +297,7 @@ class PlaygroundNode(Node):
             lidar=lidar,
             lidar_offset=self._lidar_offset,
             terrain=self.terrain,
+            levels=self.levels,
         )
 
     def _make_imu(self, rng) -> ImuSensor | None:
@@ -346,6 +350,8 @@ class PlaygroundNode(Node):
             f"speed-up x{self.speed_up:g}, {len(self.sim.obstacles)} moving obstacle(s)"
             + (f", terrain {self.description.terrain_path.name} (climbs up to "
                f"{self.terrain.max_climb_slope_deg:g} deg)" if self.terrain is not None else "")
+            + (f", levels {', '.join(self.levels.level_names)} (on {self.sim.level})"
+               if self.levels is not None else "")
         )
         self._loop.start()
 

@@ -211,6 +211,8 @@ class RobotPort:
         )
         if self.terrain is not None:
             truth.pose.pose.position.z = self.terrain.height(robot.x, robot.y)
+        elif self.sim.levels is not None:
+            truth.pose.pose.position.z = self.sim.z
         self._truth_pub.publish(truth)
 
     def publish_imu(self, stamp: float) -> None:

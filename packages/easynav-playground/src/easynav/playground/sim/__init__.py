@@ -12,6 +12,7 @@ from easynav.playground.sim.imu_sensor import ImuReading, ImuSensor
 from easynav.playground.sim.laser_scanner import LaserScanner
 from easynav.playground.sim.lidar_3d import Lidar3D
 from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.multilevel import MultiLevelWorld
 from easynav.playground.sim.ray_casting import cast_rays_discs, cast_rays_grid
 from easynav.playground.sim.scripted_obstacle import ScriptedObstacle
 from easynav.playground.sim.simulation import Simulation
@@ -34,6 +35,7 @@ __all__ = [
     "LaserScanner",
     "Lidar3D",
     "MovingObstacle",
+    "MultiLevelWorld",
     "PeerRobot",
     "ScriptedObstacle",
     "Simulation",

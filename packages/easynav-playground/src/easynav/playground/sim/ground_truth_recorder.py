@@ -15,7 +15,11 @@ class GroundTruthRecorder:
     Trajectories are lists of ``(stamp, x, y, yaw)``. The localisation error pairs each
     estimate with the true pose interpolated at the estimate's stamp. On a world with terrain,
     :attr:`terrain` lists ``(stamp, z, slope)`` with each true pose: the ground height (m) and
-    slope (rad) under the robot (empty on flat worlds, and then absent from the saved file).
+    slope (rad) under the robot (empty on flat worlds, and then absent from the saved file). On a
+    multi-level world, :attr:`levels` lists ``(stamp, level, z, pitch)`` with each true pose: the
+    level the robot is on (a floor's or a ramp's name), its height (m) and pitch (rad, REP-103:
+    negative nose up), so the true pose is ``(x, y, z, yaw)`` and the level (empty elsewhere, and
+    then absent from the saved file).
 
     Thread contract: not thread-safe. In the playground the simulation loop records; in the
     demo the executor thread records. Read results from the same thread or after the run.
@@ -27,6 +31,7 @@ class GroundTruthRecorder:
         self.clearances: list[tuple[float, float]] = []
         self.collisions: list[dict] = []
         self.terrain: list[tuple[float, float, float]] = []
+        self.levels: list[tuple[float, str, float, float]] = []
         self.min_clearance = math.inf
         self.min_clearance_at: tuple[float, float, float] | None = None
 
@@ -42,6 +47,10 @@ class GroundTruthRecorder:
     def record_terrain(self, stamp: float, z: float, slope: float) -> None:
         """Add the ground height ``z`` (m) and slope (rad) under the robot at ``stamp``."""
         self.terrain.append((float(stamp), float(z), float(slope)))
+
+    def record_level(self, stamp: float, level: str, z: float, pitch: float) -> None:
+        """Add the level, height ``z`` (m) and pitch (rad) of the robot at ``stamp``."""
+        self.levels.append((float(stamp), str(level), float(z), float(pitch)))
 
     def max_slope(self, start: float = -math.inf, end: float = math.inf) -> float:
         """The steepest slope (rad) under the robot between two stamps; NaN without terrain
@@ -111,6 +120,8 @@ class GroundTruthRecorder:
         }
         if self.terrain:
             data["terrain"] = self.terrain
+        if self.levels:
+            data["levels"] = self.levels
         return data
 
     def save(self, path: str | Path) -> None:
@@ -138,6 +149,7 @@ class GroundTruthRecorder:
         rec.clearances = [tuple(c) for c in data["clearances"]]
         rec.collisions = list(data["collisions"])
         rec.terrain = [tuple(t) for t in data.get("terrain", ())]
+        rec.levels = [tuple(t) for t in data.get("levels", ())]
         if data.get("min_clearance") is not None:
             rec.min_clearance = float(data["min_clearance"])
             at = data.get("min_clearance_at")

@@ -80,14 +80,20 @@ class LaserScanner:
         y: float,
         yaw: float,
         obstacles: Sequence[MovingObstacle] = (),
+        stretch: np.ndarray | None = None,
     ) -> np.ndarray:
-        """Ranges (m, float64, ``(beams,)``) seen from scanner pose ``(x, y, yaw)`` in the world."""
+        """Ranges (m, float64, ``(beams,)``) seen from scanner pose ``(x, y, yaw)`` in the world.
+
+        ``stretch`` (``(beams,)``, >= 1): each beam's length per metre of its horizontal
+        advance, for a scan plane that is not level (a robot on a ramp); None: level."""
         directions = self.angles + yaw
         ranges = cast_rays_grid(world, x, y, directions, self.max_range)
         if obstacles:
             centres = np.array([o.position for o in obstacles], dtype=float)
             radii = np.array([o.radius for o in obstacles], dtype=float)
             ranges = np.minimum(ranges, cast_rays_discs(x, y, directions, centres, radii))
+        if stretch is not None:
+            ranges = ranges * stretch
         finite = np.isfinite(ranges)
         if self.range_noise_std > 0.0:
             ranges[finite] += self._rng.normal(0.0, self.range_noise_std, int(finite.sum()))

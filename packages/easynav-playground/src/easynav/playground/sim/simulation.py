@@ -16,6 +16,7 @@ from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.sim.laser_scanner import LaserScanner
 from easynav.playground.sim.lidar_3d import Lidar3D
 from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.multilevel import MultiLevelWorld
 from easynav.playground.sim.terrain import Terrain
 from easynav.playground.sim.wheel_odometry import WheelOdometry
 from easynav.playground.sim.world import World
@@ -66,6 +67,20 @@ class Simulation:
     height and slope under the robot with every true pose (:meth:`GroundTruthRecorder.
     record_terrain`). Without a terrain nothing of this applies (flat worlds).
 
+    On a multi-level world (``levels``: :class:`MultiLevelWorld`, floors joined by ramps) the
+    robot is on one level at a time (:attr:`level`, starting on ``start_level``, default the
+    world's): it changes level only across a ramp's foot or top edge
+    (:meth:`MultiLevelWorld.next_level`), its height :attr:`z` and attitude (:attr:`pitch`,
+    :attr:`roll`) follow that level's surface, its motion is laid on the surface as on a
+    terrain, it hits the walls of its level (:meth:`MultiLevelWorld.collision_world`; a move off
+    its level's area is refused as ``"edge of LEVEL"``) and its laser sees what the scan plane of
+    its level meets (:meth:`MultiLevelWorld.laser_world`; ``world``, ``boxes`` and
+    ``laser_height``/``robot_height`` are then not used: the levels carry their own). A ramp
+    steeper than the world's climb limit stops the robot as a too-steep terrain does. The recorder
+    gets ``(stamp, level, z, pitch)`` with every true pose (:meth:`GroundTruthRecorder.
+    record_level`) and the height and slope as on a terrain. :attr:`level_events` lists
+    ``(stamp, level)`` at every change.
+
     Thread contract: :meth:`step` and the callbacks run in one thread (the simulation loop);
     :meth:`set_command`, :meth:`set_held` and :meth:`teleport` may be called from any thread
     (they only store under a lock).
@@ -95,6 +110,8 @@ class Simulation:
         lidar: Lidar3D | None = None,
         lidar_offset: tuple[float, float, float, float] = (0.0, 0.0, 0.45, 0.0),
         terrain: Terrain | None = None,
+        levels: MultiLevelWorld | None = None,
+        start_level: str | None = None,
     ) -> None:
         for name, value in (("step", step), ("odom_rate", odom_rate)):
             if not (math.isfinite(value) and value > 0.0):
@@ -113,6 +130,17 @@ class Simulation:
         #: The other robots as discs (:class:`~easynav.playground.sim.fleet.PeerRobot`), set
         #: by a :class:`~easynav.playground.sim.fleet.Fleet`; empty for a robot alone.
         self.peers: list = []
+        self.levels = levels
+        self.level: str | None = None
+        self.level_events: list[tuple[float, str]] = []
+        if levels is not None:
+            if terrain is not None:
+                raise ValueError("Simulation: a world has a terrain or levels, not both")
+            self.level = start_level if start_level is not None else levels.start_level
+            levels.surface(self.level)  # KeyError: an unknown level
+            self.level_events.append((0.0, self.level))
+            self.laser_world = levels.laser_world(self.level)
+            self.collision_world = levels.collision_world(self.level)
         self.checker = CollisionChecker(self.collision_world, robot_radius)
         self.terrain = terrain
         self._slope_stop_at: tuple[float, float] | None = None
@@ -195,6 +223,32 @@ class Simulation:
         self._periodic.append([float(period), float(period), callback])
 
     # ------------------------------------------------------------------ state
+    @property
+    def z(self) -> float:
+        """Height (m) of the ground under the robot: its level's surface on a multi-level
+        world, the terrain's height, 0 on a flat world."""
+        r = self.robot
+        if self.levels is not None:
+            return self.levels.height(self.level, r.x, r.y)
+        if self.terrain is not None:
+            return self.terrain.height(r.x, r.y)
+        return 0.0
+
+    @property
+    def pitch(self) -> float:
+        """The robot's pitch (rad, REP-103: negative nose up) on a multi-level world; 0
+        elsewhere."""
+        if self.levels is None:
+            return 0.0
+        return self.levels.attitude(self.level, self.robot.yaw)[0]
+
+    @property
+    def roll(self) -> float:
+        """The robot's roll (rad, REP-103) on a multi-level world; 0 elsewhere."""
+        if self.levels is None:
+            return 0.0
+        return self.levels.attitude(self.level, self.robot.yaw)[1]
+
     def laser_pose(self) -> tuple[float, float, float]:
         """World pose of the laser ``(x, y, yaw)``."""
         r = self.robot
@@ -204,6 +258,16 @@ class Simulation:
 
     def scan_now(self) -> np.ndarray:
         """Take a scan from the current pose (no scheduling, no callbacks)."""
+        if self.levels is not None:
+            # The laser pitches with the robot: along a slope a beam is longer than its
+            # horizontal advance (the grid's distance).
+            x, y, yaw = self.laser_pose()
+            gx, gy = self.levels.surface(self.level).gradient()
+            if gx or gy:
+                directions = self.scanner.angles + yaw
+                rise = gx * np.cos(directions) + gy * np.sin(directions)
+                return self.scanner.scan(self.laser_world, x, y, yaw, self._others(),
+                                         stretch=np.sqrt(1.0 + rise * rise))
         return self.scanner.scan(self.laser_world, *self.laser_pose(), self._others())
 
     def cloud_now(self) -> np.ndarray:
@@ -257,12 +321,15 @@ class Simulation:
             self.hold_events.append((now, held))
         x, y, yaw, v, w = robot.next_state(dt, now)
         terrain = self.terrain
-        if terrain is not None and not held:
-            x, y = terrain.surface_step(robot.x, robot.y, x, y)
-        what = None if held else self.checker.colliding_with(x, y, others)
-        steep = None
-        if terrain is not None and not held and what is None:
-            steep = terrain.blocks(robot.x, robot.y, x, y)
+        if self.levels is not None and not held:
+            x, y, what, steep = self._level_move(x, y, others)
+        else:
+            if terrain is not None and not held:
+                x, y = terrain.surface_step(robot.x, robot.y, x, y)
+            what = None if held else self.checker.colliding_with(x, y, others)
+            steep = None
+            if terrain is not None and not held and what is None:
+                steep = terrain.blocks(robot.x, robot.y, x, y)
         if held:
             # Wheels blocked: commanded, not moving, and the encoders count nothing.
             robot.stop()
@@ -278,6 +345,30 @@ class Simulation:
             self.odometry.update(0.0, 0.0, dt)
         return what, steep
 
+    def _level_move(self, x: float, y: float, others: list) -> tuple:
+        """A multi-level world's part of a move to ``(x, y)`` (planned on flat ground): the
+        end on the level's surface, what stops it (or None) and the too-steep slope (or None);
+        switches :attr:`level` (and the grids) when the move is taken onto another level."""
+        levels, robot = self.levels, self.robot
+        x, y = levels.surface_step(self.level, robot.x, robot.y, x, y)
+        target = levels.next_level(self.level, robot.x, robot.y, x, y)
+        if target is None:
+            return x, y, f"edge of {self.level}", None
+        if target != self.level:
+            self.checker.world = levels.collision_world(target)
+        what = self.checker.colliding_with(x, y, others)
+        steep = None if what is not None else levels.blocks(
+            self.level, target, robot.x, robot.y, x, y)
+        if target != self.level:
+            if what is None and steep is None:
+                self.level = target
+                self.collision_world = self.checker.world
+                self.laser_world = levels.laser_world(target)
+                self.level_events.append((self.time + self.step_size, target))
+            else:
+                self.checker.world = self.collision_world
+        return x, y, what, steep
+
     def _finish_step(self, what: str | None, steep: float | None) -> None:
         """Last part of a step (after every robot and obstacle moved): the clock, collisions,
         the ground truth and the sensors that are due."""
@@ -289,7 +380,7 @@ class Simulation:
         self.time = self.steps * dt
         stamp = self.time
         collision = self.checker.record(stamp, robot.x, robot.y, what, others)
-        if terrain is not None:
+        if terrain is not None or self.levels is not None:
             collision = collision or self._slope_stop(stamp, steep)
         if collision is not None:
             self.recorder.record_collision(collision.as_dict())
@@ -304,6 +395,10 @@ class Simulation:
                 self.recorder.record_terrain(
                     stamp, terrain.height(robot.x, robot.y), terrain.slope(robot.x, robot.y)
                 )
+            elif self.levels is not None:
+                z = self.z
+                self.recorder.record_terrain(stamp, z, self.levels.slope(self.level))
+                self.recorder.record_level(stamp, self.level, z, self.pitch)
             self.recorder.record_clearance(
                 stamp, robot.x, robot.y, self.checker.clearance(robot.x, robot.y, others)
             )
@@ -336,7 +431,7 @@ class Simulation:
         if steep is None:
             return None
         self._slope_stop_at = (robot.x, robot.y)
-        limit = self.terrain.max_climb_slope_deg
+        limit = (self.terrain or self.levels).max_climb_slope_deg
         collision = Collision(
             stamp, robot.x, robot.y, f"steep slope ({math.degrees(steep):.1f} deg > {limit:g})"
         )
