@@ -43,6 +43,7 @@ PLUGIN_GROUPS = (
     "easynav.recovery_managers",
     "easynav.costmap_filters",
     "easynav.routes_filters",
+    "easynav.navmap_filters",
     "easynav.recovery.safety_reflexes",
     "easynav.recovery.evaluators",
     "easynav.recovery.mitigations",

@@ -214,3 +214,14 @@ def test_set_area():
     sq = (np.abs(navmap.centroids[:, :2] - (1.0, 1.0)) <= 0.5).all(axis=1)
     assert (layer[sq] == 9).all()
     assert not navmap.set_area((50, 50, 0), 1, "obstacles")
+
+
+def test_adjacency_pairs_cached_and_shared_by_copies():
+    navmap = grid_mesh(3, 2)
+    u, v = navmap.adjacency_pairs()
+    expected = {(c, int(n)) for c in range(navmap.num_navcels) for n in navmap.neighbors[c]
+                if n >= 0}
+    assert set(zip(u.tolist(), v.tolist(), strict=True)) == expected
+    assert len(u) == len(expected) and (np.diff(u) >= 0).all()
+    dup = navmap.copy()
+    assert dup.adjacency_pairs()[0] is u

@@ -52,28 +52,22 @@ def inflation_distances(navmap: NavMap, src: np.ndarray, radius: float) -> np.nd
         return inflation_distances_reference(navmap, src, radius)
     m = navmap.num_navcels
     seeds = np.flatnonzero(inflation_seeds(navmap, src))
-    dist = np.full(m, np.inf)
     if len(seeds) == 0:
-        return dist
-    u = np.repeat(np.arange(m), 3)
-    v = navmap.neighbors.reshape(-1)
-    ok = v >= 0
-    u, v = u[ok], v[ok]
-    ok = src[v] != NO_INFORMATION
-    u, v = u[ok], v[ok]
-    c = navmap.centroids[:, :2]
-    w = np.linalg.norm(c[u] - c[v], axis=1)
-    ok = w > 0
-    _, first = np.unique(u * m + v, return_index=True)  # csr_matrix would add duplicates
-    ok &= np.isin(np.arange(len(u)), first)
-    # one virtual source joined to every seed at weight 0 is one Dijkstra run
-    graph = csr_matrix(
-        (np.r_[w[ok], np.full(len(seeds), 1e-300)],
-         (np.r_[u[ok] + 1, np.zeros(len(seeds), np.int64)], np.r_[v[ok] + 1, seeds + 1])),
-        shape=(m + 1, m + 1),
-    )
-    out = dijkstra(graph, directed=True, indices=0, limit=radius)[1:]
-    out[seeds] = 0.0
+        return np.full(m, np.inf)
+    cache = navmap.geometry_cache
+    if "inflation_edges" not in cache:
+        u, v = navmap.adjacency_pairs()
+        c = navmap.centroids[:, :2]
+        w = np.linalg.norm(c[u] - c[v], axis=1)
+        ok = w > 0  # the original skips zero steps
+        u, v, w = u[ok], v[ok], w[ok]
+        cache["inflation_edges"] = (u, v, w, csr_matrix((w, (u, v)), shape=(m, m)))
+    u, v, w, graph = cache["inflation_edges"]
+    blocked = src[v] == NO_INFORMATION
+    if blocked.any():  # never enter an unknown NavCel
+        keep = ~blocked
+        graph = csr_matrix((w[keep], (u[keep], v[keep])), shape=(m, m))
+    out = dijkstra(graph, directed=True, indices=seeds, min_only=True, limit=radius)
     return np.where(out <= radius, out, np.inf)
 
 

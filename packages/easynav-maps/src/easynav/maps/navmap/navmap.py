@@ -109,6 +109,8 @@ class NavMap:
             array.flags.writeable = False
         self._grid: TriangleGrid | None = None
         self._layers: dict[str, np.ndarray] = {}
+        #: Structures derived from the geometry, computed on demand, shared by the copies.
+        self.geometry_cache: dict = {}
 
     # -- geometry ---------------------------------------------------------------------------
     @property
@@ -164,6 +166,21 @@ class NavMap:
     def navcel_neighbors(self, cid: int) -> list[int]:
         """The up-to-3 NavCels sharing an edge with ``cid`` (borders skipped)."""
         return [int(n) for n in self._neighbors[cid] if n >= 0]
+
+    def adjacency_pairs(self) -> tuple[np.ndarray, np.ndarray]:
+        """Directed neighbour pairs ``(u, v)`` (each shared edge both ways, duplicates removed),
+        int64 arrays sorted by ``u``; cached in :attr:`geometry_cache`."""
+        pairs = self.geometry_cache.get("adjacency_pairs")
+        if pairs is None:
+            m = self.num_navcels
+            u = np.repeat(np.arange(m, dtype=np.int64), 3)
+            v = self._neighbors.reshape(-1)
+            keys = np.unique(u[v >= 0] * max(m, 1) + v[v >= 0])
+            pairs = (keys // max(m, 1), keys % max(m, 1))
+            for a in pairs:
+                a.flags.writeable = False
+            self.geometry_cache["adjacency_pairs"] = pairs
+        return pairs
 
     def boundary_mask(self) -> np.ndarray:
         """(M,) bool: NavCels with fewer than 3 neighbours (on the border of the surface)."""
