@@ -335,3 +335,27 @@ def test_ros_messages():
     np.testing.assert_allclose(table[:, :3], navmap.centroids, atol=1e-6)
     assert [f.name for f in cloud.fields] == ["x", "y", "z", "obstacles"]
     assert table[1, 3] == 254
+
+
+def test_marker_bytes_are_the_cdr_of_the_same_marker():
+    pytest.importorskip("visualization_msgs.msg")
+    from geometry_msgs.msg import Point
+    from rclpy.serialization import deserialize_message
+    from std_msgs.msg import ColorRGBA
+    from visualization_msgs.msg import Marker
+
+    from easynav.maps.navmap.navmap_ros import navmap_marker_cdr
+
+    navmap = NavMap([[0, 0, 0], [1, 0, 0.5], [0, 1, 0]], [[0, 1, 2]])
+    navmap.set_layer("obstacles", np.array([254], np.uint8))
+    expected = Marker()
+    expected.header.frame_id = "odom"
+    expected.header.stamp.sec, expected.header.stamp.nanosec = 3, 250_000_000
+    expected.ns, expected.type = "navmap", Marker.TRIANGLE_LIST
+    expected.pose.orientation.w = 1.0
+    expected.scale.x = expected.scale.y = expected.scale.z = 1.0
+    expected.color.r = expected.color.g = expected.color.b = expected.color.a = 1.0
+    expected.points = [Point(x=0.0, y=0.0, z=0.0), Point(x=1.0, y=0.0, z=0.5),
+                       Point(x=0.0, y=1.0, z=0.0)]
+    expected.colors = [ColorRGBA(r=0.0, g=0.0, b=0.0, a=1.0)] * 3
+    assert deserialize_message(navmap_marker_cdr(navmap, "odom", 3.25), Marker) == expected

@@ -311,9 +311,9 @@ class NavMapMapsManager(MapsManagerBase):
                 f"{self._ros.topic('map')} (more than {MAX_MARKER_NAVCELS})"
             )
             return
-        from easynav.maps.navmap.navmap_ros import navmap_to_marker
+        from easynav.maps.navmap.navmap_ros import navmap_marker_cdr
 
-        publisher.publish(navmap_to_marker(navmap, self._frame(), float(self.now())))
+        publisher.publish(navmap_marker_cdr(navmap, self._frame(), float(self.now())))
 
     def _publish_layer(self, navmap: NavMap, layer: str) -> None:
         publisher = self._ros.get("map_updates")

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from easynav.maps.navmap.cdr import CdrBuffer
 from easynav.maps.navmap.navmap import LETHAL_OBSTACLE, NO_INFORMATION, NavMap
 
 
@@ -27,37 +28,60 @@ def cost_colors(values: np.ndarray) -> np.ndarray:
     return rgba.astype(np.float32)
 
 
-def navmap_to_marker(navmap: NavMap, frame_id: str, stamp: float, layer: str | None = None,
-                     namespace: str = "navmap") -> Any:
-    """A TRIANGLE_LIST Marker of the mesh; each NavCel coloured by ``layer`` (a uint8 cost
-    layer; the first of ``inflated_obstacles``, ``obstacles``, ``occupancy`` present when
-    None; uniform grey when none)."""
-    from geometry_msgs.msg import Point
-    from std_msgs.msg import ColorRGBA
-    from visualization_msgs.msg import Marker
+def navmap_marker_cdr(navmap: NavMap, frame_id: str, stamp: float, layer: str | None = None,
+                      namespace: str = "navmap") -> bytes:
+    """The CDR serialisation of a ``visualization_msgs/Marker`` TRIANGLE_LIST of the mesh, ready
+    for ``Publisher.publish`` (rclpy publishes bytes as they are): each NavCel coloured by
+    ``layer`` (a uint8 cost layer; the first of ``inflated_obstacles``, ``obstacles``,
+    ``occupancy`` present when None; uniform grey when none).
 
-    from easynav.core.tf.ros_conversion import seconds_to_stamp
-
-    msg = Marker()
-    msg.header.frame_id = frame_id
-    seconds_to_stamp(stamp, msg.header.stamp)
-    msg.ns = namespace
-    msg.id = 0
-    msg.type = Marker.TRIANGLE_LIST
-    msg.action = Marker.ADD
-    msg.pose.orientation.w = 1.0
-    msg.scale.x = msg.scale.y = msg.scale.z = 1.0
-    msg.color.a = 1.0
+    Written with numpy, not through a million ``Point`` objects: 295k NavCels take well under a
+    second instead of 16 s (rclpy message construction)."""
     if layer is None:
         layer = next((n for n in ("inflated_obstacles", "obstacles", "occupancy")
                       if navmap.has_layer(n)), None)
     values = navmap.layer(layer) if layer is not None else np.zeros(navmap.num_navcels)
-    corners = navmap.vertices[navmap.faces].reshape(-1, 3)
-    msg.points = [Point(x=float(x), y=float(y), z=float(z)) for x, y, z in corners]
-    colors = [ColorRGBA(r=float(r), g=float(g), b=float(b), a=float(a))
-              for r, g, b, a in cost_colors(values)]
-    msg.colors = [c for c in colors for _ in range(3)]
-    return msg
+    sec = int(np.floor(stamp))
+    buf = CdrBuffer()
+    buf.write("i", sec)  # header
+    buf.write("I", min(int(round((stamp - sec) * 1e9)), 999_999_999))
+    buf.write_string(frame_id)
+    buf.write_string(namespace)
+    buf.write("i", 0)  # id
+    buf.write("i", 11)  # type TRIANGLE_LIST
+    buf.write("i", 0)  # action ADD
+    for value in (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0):  # pose, scale
+        buf.write("d", value)
+    for value in (1.0, 1.0, 1.0, 1.0):  # color
+        buf.write("f", value)
+    buf.write("i", 0)  # lifetime
+    buf.write("I", 0)
+    buf.write("?", False)  # frame_locked
+    buf.write_array(navmap.vertices[navmap.faces].reshape(-1, 3), np.float64)  # points
+    buf.write_array(np.repeat(cost_colors(values), 3, axis=0), np.float32)  # colors
+    buf.write_string("")  # texture_resource
+    buf.write("i", 0)  # texture: header, format, data
+    buf.write("I", 0)
+    buf.write_string("")
+    buf.write_string("")
+    buf.write_array([], np.uint8)
+    buf.write("I", 0)  # uv_coordinates
+    buf.write_string("")  # text
+    buf.write_string("")  # mesh_resource
+    buf.write_string("")  # mesh_file: filename, data
+    buf.write_array([], np.uint8)
+    buf.write("?", False)  # mesh_use_embedded_materials
+    return buf.getvalue()
+
+
+def navmap_to_marker(navmap: NavMap, frame_id: str, stamp: float, layer: str | None = None,
+                     namespace: str = "navmap") -> Any:
+    """:func:`navmap_marker_cdr` as a ``visualization_msgs/Marker`` message object."""
+    from rclpy.serialization import deserialize_message
+    from visualization_msgs.msg import Marker
+
+    return deserialize_message(navmap_marker_cdr(navmap, frame_id, stamp, layer, namespace),
+                               Marker)
 
 
 def layer_to_point_cloud2(navmap: NavMap, layer: str, frame_id: str, stamp: float) -> Any:
