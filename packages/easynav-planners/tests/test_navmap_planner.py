@@ -1,0 +1,392 @@
+"""NavMapAStarPlanner without ROS: optimal costs against Dijkstra, two floors, slopes, costs,
+smoothing on the surface."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import DictParameters, PluginContext
+from easynav.core.types import (
+    DiagnosticLevel,
+    DiagnosticStatus,
+    Goals,
+    Header,
+    Odometry,
+    Path,
+    Pose,
+    PoseStamped,
+)
+from easynav.maps.navmap import NavMap
+from easynav.planners.navmap_astar import (
+    astar_navmap,
+    astar_navmap_reference,
+    compiled_available,
+    path_cost,
+    step_multipliers,
+)
+from easynav.planners.navmap_planner import (
+    NavMapAStarPlanner,
+    clamp_to_triangles,
+    smooth_on_navcels,
+)
+
+_namespaces = itertools.count()
+RES = 0.1
+
+
+# -- meshes --------------------------------------------------------------------------
+def patch(x0, x1, y0, y1, z=lambda x, y: 0.0 * x, res=RES):
+    """Vertices and faces of a quad grid over [x0, x1] x [y0, y1] with height z(x, y)."""
+    nx, ny = round((x1 - x0) / res), round((y1 - y0) / res)
+    xs, ys = np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
+    xx, yy = np.meshgrid(xs, ys)
+    vertices = np.column_stack([xx.ravel(), yy.ravel(), z(xx, yy).ravel()])
+    j, i = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
+    v00 = (j * (nx + 1) + i).ravel()
+    v10, v01, v11 = v00 + 1, v00 + nx + 1, v00 + nx + 2
+    faces = np.vstack([np.column_stack([v00, v10, v11]), np.column_stack([v00, v11, v01])])
+    return vertices, faces
+
+
+def merge(*patches) -> NavMap:
+    """One NavMap of the patches, vertices at the same place merged (shared edges connect)."""
+    vertices, faces, offset = [], [], 0
+    for v, f in patches:
+        vertices.append(v)
+        faces.append(f + offset)
+        offset += len(v)
+    vertices, faces = np.vstack(vertices), np.vstack(faces)
+    _, first, inverse = np.unique(np.round(vertices, 6), axis=0, return_index=True,
+                                  return_inverse=True)
+    return NavMap(vertices[first], inverse.reshape(-1)[faces])
+
+
+def two_floors() -> NavMap:
+    """Ground floor (z 0) x 0..10, y 0..2 with a landing x 9..10, y 2..3; a ramp x 5..9,
+    y 2..3 from z 0 at x 9 to 1.5 at x 5 (20.6 deg); an upper floor (z 1.5) x 0..5, y 0..3
+    right above the ground floor's x 0..5."""
+    return merge(
+        patch(0, 10, 0, 2),
+        patch(9, 10, 2, 3),
+        patch(5, 9, 2, 3, lambda x, y: 1.5 * (9 - x) / 4 + 0 * y),
+        patch(0, 5, 0, 3, lambda x, y: 1.5 + 0 * x),
+    )
+
+
+def steep_and_gentle() -> NavMap:
+    """Ground (z 0) x 0..2, y 0..7 and an upper floor (z 1) x 3..5, y 0..7, joined by a steep
+    ramp x 2..3, y 0..1 (45 deg) and by a gentle detour: a landing x 2..3, y 6..7 (z 0), a ramp
+    x 2..3, y 2..6 (z 1 at y 2, 0 at y 6: 14 deg), a landing x 2..3, y 1..2 (z 1)."""
+    return merge(
+        patch(0, 2, 0, 7),
+        patch(3, 5, 0, 7, lambda x, y: 1.0 + 0 * x),
+        patch(2, 3, 0, 1, lambda x, y: x - 2.0 + 0 * y),
+        patch(2, 3, 6, 7),
+        patch(2, 3, 2, 6, lambda x, y: (6.0 - y) / 4.0 + 0 * x),
+        patch(2, 3, 1, 2, lambda x, y: 1.0 + 0 * x),
+    )
+
+
+def random_mesh(rng, n=24) -> NavMap:
+    """A jittered heightfield grid of n x n quads, random diagonals."""
+    xs, ys = np.meshgrid(np.arange(n + 1, dtype=float), np.arange(n + 1, dtype=float))
+    xy = np.column_stack([xs.ravel(), ys.ravel()]) * 0.2
+    xy += rng.uniform(-0.06, 0.06, xy.shape)
+    z = rng.uniform(0.0, 0.3, len(xy))
+    vertices = np.column_stack([xy, z])
+    j, i = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    v00 = (j * (n + 1) + i).ravel()
+    v10, v01, v11 = v00 + 1, v00 + n + 1, v00 + n + 2
+    flip = rng.random(len(v00)) < 0.5
+    a = np.where(flip, np.column_stack([v00, v10, v01]).T, np.column_stack([v00, v10, v11]).T).T
+    b = np.where(flip, np.column_stack([v10, v11, v01]).T, np.column_stack([v00, v11, v01]).T).T
+    return NavMap(vertices, np.vstack([a, b]))
+
+
+def dijkstra_cost(navmap: NavMap, mult: np.ndarray, start: int, goal: int) -> float:
+    """Cheapest cost by scipy's Dijkstra over the NavCel graph with the planner's weights."""
+    u, v = navmap.adjacency_pairs()
+    keep = np.isfinite(mult[v])
+    u, v = u[keep], v[keep]
+    w = np.linalg.norm(navmap.centroids[u] - navmap.centroids[v], axis=1) * mult[v]
+    m = navmap.num_navcels
+    graph = csr_matrix((w, (u, v)), shape=(m, m))
+    return float(dijkstra(graph, directed=True, indices=start)[goal])
+
+
+# -- planner harness --------------------------------------------------------------------------
+def make_planner(params=None) -> NavMapAStarPlanner:
+    context = PluginContext(
+        parameters=DictParameters({f"navmap.{k}": v for k, v in (params or {}).items()}),
+        namespace=f"navmap_planner_test_{next(_namespaces)}",
+        now=lambda: 7.0,
+    )
+    planner = NavMapAStarPlanner()
+    planner.initialize(context, "navmap")
+    return planner
+
+
+def state_with(navmap, goal, robot=(0.5, 0.5, 0.0)) -> NavState:
+    """``goal`` and ``robot`` are (x, y, z[, yaw])."""
+    nav_state = NavState()
+    nav_state.set("map.navmap", navmap)
+    nav_state.set("robot_pose", Odometry(Header(3.0, "map"), "base_footprint",
+                                         Pose.from_xy_yaw(robot[0], robot[1], 0.0, robot[2])))
+    yaw = goal[3] if len(goal) > 3 else 0.0
+    g = PoseStamped(Header(5.0, "map"), Pose.from_xy_yaw(goal[0], goal[1], yaw, goal[2]))
+    nav_state.set("goals", Goals(Header(5.0, "map"), [g]))
+    return nav_state
+
+
+def plan(navmap, goal, robot=(0.5, 0.5, 0.0), params=None):
+    planner = make_planner(params)
+    nav_state = state_with(navmap, goal, robot)
+    planner.update(nav_state)
+    return planner, nav_state, nav_state.get("path", Path)
+
+
+def points(path: Path) -> np.ndarray:
+    return np.array([[p.x, p.y, p.z] for p in path.poses])
+
+
+def diagnostic(nav_state) -> DiagnosticStatus:
+    status = nav_state.get("diagnostics.path", DiagnosticStatus)
+    assert status.hardware_id == "planner"
+    return status
+
+
+def planner_cells(planner, navmap, nav_state):
+    """The NavCels of the planner's last search."""
+    return planner._last_cells
+
+
+# -- optimal costs --------------------------------------------------------------------------
+@pytest.mark.parametrize("seed", range(6))
+def test_astar_cost_equals_dijkstra_on_random_meshes(seed):
+    rng = np.random.default_rng(seed)
+    navmap = random_mesh(rng)
+    costs = rng.choice([0, 0, 0, 50, 120, 200, 253, 254, 255], navmap.num_navcels).astype(np.uint8)
+    mult = step_multipliers(costs, navmap.num_navcels, rng.uniform(0.5, 3.0), rng.uniform(0, 8))
+    free = np.flatnonzero(np.isfinite(mult))
+    for _ in range(5):
+        s, g = (int(c) for c in rng.choice(free, 2, replace=False))
+        expected = dijkstra_cost(navmap, mult, s, g)
+        ref_path, ref_cost = astar_navmap_reference(navmap.neighbors, navmap.centroids, mult,
+                                                    s, g)
+        fast_path, fast_cost = astar_navmap(navmap.neighbors, navmap.centroids, mult, s, g)
+        if math.isinf(expected):
+            assert ref_path is None and fast_path is None
+            continue
+        assert ref_cost == pytest.approx(expected, rel=1e-9)
+        assert fast_cost == pytest.approx(expected, rel=1e-9)
+        for cells in (ref_path, fast_path):
+            cells = np.asarray(cells)
+            assert cells[0] == s and cells[-1] == g
+            assert all(b in navmap.neighbors[a] for a, b in zip(cells[:-1], cells[1:],
+                                                                  strict=True))
+            assert path_cost(navmap.centroids, mult, cells) == pytest.approx(expected, rel=1e-9)
+
+
+def test_compiled_search_is_available():
+    assert compiled_available()
+
+
+def test_two_floors_path_climbs_the_ramp_and_costs_what_dijkstra_says():
+    navmap = two_floors()
+    # The ground floor's (1, 1) and the upper floor's (1, 1) are 1.5 m apart vertically.
+    planner, nav_state, path = plan(navmap, (1.0, 1.0, 1.5, 0.7), robot=(1.0, 1.0, 0.0))
+    pts = points(path)
+    assert pts[0] == pytest.approx([1.0, 1.0, 0.0])
+    assert pts[-1] == pytest.approx([1.0, 1.0, 1.5])
+    assert path.poses[-1].yaw == pytest.approx(0.7)
+    # Out along the ground floor, up the ramp (x 9 -> 5 at y 2..3), back on the upper floor.
+    assert pts[:, 0].max() > 8.9 and (pts[:, 2] > 0.1).any()
+    on_ramp = (pts[:, 0] > 5.2) & (pts[:, 0] < 8.8) & (pts[:, 2] > 0.05)
+    assert (pts[on_ramp, 1] > 2.0).all()
+    np.testing.assert_allclose(pts[on_ramp, 2], 1.5 * (9 - pts[on_ramp, 0]) / 4, atol=1e-9)
+    cells = planner_cells(planner, navmap, nav_state)
+    mult = step_multipliers(None, navmap.num_navcels, 2.0, 5.0)
+    expected = dijkstra_cost(navmap, mult, int(cells[0]), int(cells[-1]))
+    assert path_cost(navmap.centroids, mult, cells) == pytest.approx(expected, rel=1e-9)
+    ref, _ = astar_navmap_reference(navmap.neighbors, navmap.centroids, mult, int(cells[0]),
+                                    int(cells[-1]))
+    assert ref[0] == cells[0]
+    status = diagnostic(nav_state)
+    assert status.level == DiagnosticLevel.OK and "path of" in status.message
+    # The same xy goal at z 0 is the ground floor: a short straight path.
+    _, _, low = plan(navmap, (1.0, 1.8, 0.0), robot=(1.0, 1.0, 0.0))
+    assert (points(low)[:, 2] == 0.0).all() and len(low) < 25
+
+
+# -- slopes --------------------------------------------------------------------------
+def test_slope_limit_takes_the_gentle_detour_no_limit_the_steep_ramp():
+    navmap = steep_and_gentle()
+    goal, robot = (4.0, 0.5, 1.0), (1.0, 0.5, 0.0)
+    _, _, steep = plan(navmap, goal, robot)
+    assert (points(steep)[:, 1] < 1.2).all()  # straight up the 45 deg ramp
+    _, nav_state, gentle = plan(navmap, goal, robot, {"max_allowed_slope_deg": 30.0})
+    pts = points(gentle)
+    assert pts[:, 1].max() > 6.0  # round by the far landing and the 14 deg ramp
+    assert pts[-1] == pytest.approx([4.0, 0.5, 1.0])
+    # Nothing steeper than the limit is entered.
+    cells, _ = navmap.locate(pts)
+    slopes = np.degrees(np.arccos(np.abs(navmap.normals[cells, 2])))
+    assert slopes.max() < 30.0
+    assert diagnostic(nav_state).level == DiagnosticLevel.OK
+
+
+def test_no_route_within_the_slope_limit_and_a_goal_on_a_steep_navcel():
+    navmap = steep_and_gentle()
+    planner, nav_state, path = plan(navmap, (4.0, 0.5, 1.0), (1.0, 0.5, 0.0),
+                                    {"max_allowed_slope_deg": 10.0})
+    assert len(path) == 0
+    assert "slopes above 10 deg" in diagnostic(nav_state).message
+    assert planner.take_goal_rejection() is None
+    planner, nav_state, path = plan(navmap, (2.5, 0.5, 0.5), (1.0, 0.5, 0.0),
+                                    {"max_allowed_slope_deg": 30.0})
+    assert len(path) == 0
+    assert "sloped 45.0 deg" in diagnostic(nav_state).message
+    assert "sloped 45.0 deg" in planner.take_goal_rejection()
+
+
+# -- costs --------------------------------------------------------------------------
+@pytest.mark.parametrize("layer", ["obstacles", "inflated_obstacles"])
+@pytest.mark.parametrize(("value", "words"), [(254, "on an obstacle (cost 254)"),
+                                              (255, "on unknown space (cost 255)")])
+def test_goal_or_start_on_lethal_or_unknown_gives_an_empty_path_and_says_why(layer, value,
+                                                                              words):
+    navmap = merge(patch(0, 6, 0, 3))
+    goal_cid = navmap.locate_navcel((5.0, 1.5, 0.0))
+    navmap.add_layer(layer)[goal_cid] = value
+    planner, nav_state, path = plan(navmap, (5.0, 1.5, 0.0))
+    assert len(path) == 0
+    status = diagnostic(nav_state)
+    assert status.level == DiagnosticLevel.WARN
+    assert status.message == f"goal (5.00, 1.50) is {words} in NavMap layer '{layer}'"
+    assert planner.take_goal_rejection() is None  # may clear: the recovery system decides
+    # The robot on it.
+    _, nav_state, path = plan(navmap, (1.0, 1.0, 0.0), robot=(5.0, 1.5, 0.0))
+    assert len(path) == 0
+    assert f"the robot (5.00, 1.50, 0.00) is {words}" in diagnostic(nav_state).message
+
+
+def test_a_goal_off_the_mesh_is_rejected():
+    navmap = merge(patch(0, 6, 0, 3))
+    planner, nav_state, path = plan(navmap, (8.0, 1.0, 0.0))
+    assert len(path) == 0
+    assert "is not on the NavMap" in planner.take_goal_rejection()
+
+
+def test_layer_costs_push_the_path_away():
+    navmap = merge(patch(0, 6, 0, 4))
+    c = navmap.centroids
+    band = (np.abs(c[:, 0] - 3.0) < 0.5) & (c[:, 1] < 3.0)
+    navmap.add_layer("inflated_obstacles")[band] = 250
+    navmap.add_layer("obstacles")  # all free: the inflated layer wins
+    goal, robot = (5.5, 1.5, 0.0), (0.5, 1.5, 0.0)
+    _, _, around = plan(navmap, goal, robot)
+    pts = points(around)
+    middle = np.abs(pts[:, 0] - 3.0) < 0.4
+    assert middle.any() and (pts[middle, 1] > 3.0).all()
+    # Without the penalty the costs do not matter: straight through.
+    _, _, straight = plan(navmap, goal, robot, {"inflation_penalty": 0.0})
+    assert np.abs(points(straight)[:, 1] - 1.5).max() < 0.2
+
+
+def test_a_blocked_route_gives_an_empty_path():
+    navmap = merge(patch(0, 6, 0, 3))
+    navmap.add_layer("obstacles")[np.abs(navmap.centroids[:, 0] - 3.0) < 0.1] = 254
+    planner, nav_state, path = plan(navmap, (5.0, 1.5, 0.0))
+    assert len(path) == 0
+    assert "no route from (0.50, 0.50, 0.00) to goal (5.00, 1.50): blocked by layer " \
+           "'obstacles'" == diagnostic(nav_state).message
+    assert planner.take_goal_rejection() is None
+
+
+# -- smoothing and poses -----------------------------------------------------------------------
+def test_smoothing_keeps_the_ends_and_every_point_on_its_triangle():
+    navmap = two_floors()
+    start, goal = navmap.locate_navcel((1.0, 1.0, 0.0)), navmap.locate_navcel((1.0, 1.0, 1.5))
+    mult = step_multipliers(None, navmap.num_navcels)
+    cells, _ = astar_navmap(navmap.neighbors, navmap.centroids, mult, start, goal)
+    raw = navmap.centroids[cells]
+    smooth = smooth_on_navcels(raw, cells, navmap)
+    assert smooth[0] == pytest.approx(raw[0]) and smooth[-1] == pytest.approx(raw[-1])
+    assert not np.allclose(smooth, raw)
+    length = np.linalg.norm(np.diff(smooth, axis=0), axis=1).sum()
+    assert length < np.linalg.norm(np.diff(raw, axis=0), axis=1).sum()
+    # Each point inside its own NavCel's xy triangle, z on its plane.
+    tri = navmap.vertices[navmap.faces[cells]]
+    again = clamp_to_triangles(smooth[:, :2], tri)
+    np.testing.assert_allclose(again, smooth, atol=1e-9)
+    heights = navmap.locate(smooth)[1]
+    np.testing.assert_allclose(heights, smooth[:, 2], atol=1e-9)
+
+
+def test_clamp_to_triangles_projects_outside_points_to_the_nearest_edge():
+    tri = np.array([[[0, 0, 0], [1, 0, 1], [0, 1, 2]]], dtype=float)
+    assert clamp_to_triangles([[0.25, 0.25]], tri)[0] == pytest.approx([0.25, 0.25, 0.75])
+    assert clamp_to_triangles([[2.0, -1.0]], tri)[0] == pytest.approx([1.0, 0.0, 1.0])
+    assert clamp_to_triangles([[1.0, 1.0]], tri)[0] == pytest.approx([0.5, 0.5, 1.5])
+
+
+def test_poses_face_the_next_and_the_last_takes_the_goal_yaw():
+    navmap = merge(patch(0, 6, 0, 3))
+    _, _, path = plan(navmap, (5.0, 2.5, 0.0, -1.0))
+    pts = points(path)
+    d = np.diff(pts, axis=0)
+    np.testing.assert_allclose([p.yaw for p in path.poses[:-1]], np.arctan2(d[:, 1], d[:, 0]))
+    assert path.poses[-1].yaw == pytest.approx(-1.0)
+    assert path.header.frame_id == "map" and path.header.stamp == 7.0
+    # On the goal's NavCel already: the goal alone.
+    goal_cid = navmap.locate_navcel((5.0, 2.5, 0.0))
+    inside = navmap.centroids[goal_cid]
+    _, _, one = plan(navmap, (5.0, 2.5, 0.0, -1.0), robot=(inside[0], inside[1], 0.0))
+    np.testing.assert_allclose(points(one), [[5.0, 2.5, 0.0]])
+
+
+def test_continuous_replan_false_keeps_the_path_until_it_is_blocked():
+    navmap = merge(patch(0, 6, 0, 3))
+    planner = make_planner({"continuous_replan": False})
+    nav_state = state_with(navmap, (5.0, 1.5, 0.0))
+    planner.update(nav_state)
+    first = nav_state.get("path", Path)
+    nav_state.set("robot_pose", Odometry(Header(3.0, "map"), "base_footprint",
+                                         Pose.from_xy_yaw(1.0, 1.0, 0.0)))
+    planner.update(nav_state)
+    assert nav_state.get("path", Path) is first
+    blocked = navmap.copy()
+    cells, _ = blocked.locate(points(first)[len(first) // 2][None, :])
+    blocked.add_layer("obstacles")[cells] = 254
+    nav_state.set("map.navmap", blocked)
+    planner.update(nav_state)
+    second = nav_state.get("path", Path)
+    assert second is not first and len(second) > 0
+    assert points(second)[0] == pytest.approx([1.0, 1.0, 0.0])
+
+
+def test_robot_just_off_the_mesh_starts_from_the_nearest_navcel_far_off_fails():
+    navmap = merge(patch(0, 6, 0, 3))
+    _, _, path = plan(navmap, (5.0, 1.5, 0.0), robot=(-0.1, 1.0, 0.0))
+    assert len(path) > 0
+    _, nav_state, path = plan(navmap, (5.0, 1.5, 0.0), robot=(-3.0, 1.0, 0.0))
+    assert len(path) == 0 and "is off the NavMap" in diagnostic(nav_state).message
+
+
+def test_no_navmap_yet():
+    planner = make_planner()
+    nav_state = state_with(merge(patch(0, 1, 0, 1)), (0.5, 0.5, 0.0))
+    nav_state = NavState()
+    nav_state.set("robot_pose", Odometry(Header(3.0, "map"), "base_footprint", Pose()))
+    nav_state.set("goals", Goals(Header(5.0, "map"), [PoseStamped(Header(5.0, "map"),
+                                                                   Pose.from_xy_yaw(1, 1))]))
+    planner.update(nav_state)
+    assert len(nav_state.get("path", Path)) == 0
+    assert "no NavMap yet" in diagnostic(nav_state).message
