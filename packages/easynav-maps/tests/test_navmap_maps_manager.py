@@ -103,6 +103,12 @@ def test_navmap_file_loaded_after_occmap(tmp_path):
     assert manager.navmap.num_navcels == 1
 
 
+def test_navmap_path_file_may_be_a_mesh(tmp_path):
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0.2\nv 0 1 0.2\nf 1 2 3 4\n")
+    manager = make_manager({"navmap_path_file": str(tmp_path / "m.obj")})
+    assert manager.navmap.num_navcels == 2 and manager.navmap.frame_id == "map"
+
+
 @pytest.mark.parametrize("param", ["occmap_path_file", "navmap_path_file"])
 def test_missing_file_fails_configure(tmp_path, param):
     with pytest.raises(PluginConfigurationError, match=f"navmap.{param}.*nope"):

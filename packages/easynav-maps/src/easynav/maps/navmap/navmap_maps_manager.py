@@ -17,6 +17,7 @@ from easynav.maps.map_file_resolver import resolve_map_file
 from easynav.maps.map_format_error import MapFormatError
 from easynav.maps.navmap.builders import (
     navmap_from_map_yaml,
+    navmap_from_mesh_file,
     navmap_from_occupancy_grid,
     navmap_from_points,
 )
@@ -39,12 +40,13 @@ class NavMapMapsManager(MapsManagerBase):
     Parameters (under ``<alias>.``): ``package`` with ``occmap_path_file`` (a map_server YAML,
     converted as the original's ``from_occupancy_grid``: two NavCels per cell, layer
     ``occupancy``) and/or ``navmap_path_file`` (the original's ``.navmap`` file), loaded in that
-    order — both set, the second replaces the first. With ``package`` empty the file parameters
-    are paths (:func:`easynav.maps.resolve_map_file`). ``filters`` lists filter aliases in
-    order; each names its plugin in ``<alias>.<filter>.plugin`` (entry-point group
-    ``easynav.navmap_filters``) and its parameters under ``<alias>.<filter>.*``. A missing or
-    malformed file, or a filter that fails to load, fails configure (the original logs an
-    error for a bad ``.navmap`` file and runs without a map).
+    order — both set, the second replaces the first. Beyond the original, ``navmap_path_file``
+    may also name a PLY or OBJ mesh (:func:`navmap_from_mesh_file`; no layers). With ``package``
+    empty the file parameters are paths (:func:`easynav.maps.resolve_map_file`). ``filters``
+    lists filter aliases in order; each names its plugin in ``<alias>.<filter>.plugin``
+    (entry-point group ``easynav.navmap_filters``) and its parameters under
+    ``<alias>.<filter>.*``. A missing or malformed file, or a filter that fails to load, fails
+    configure (the original logs an error for a bad ``.navmap`` file and runs without a map).
 
     NavState ``map.navmap`` (:class:`NavMap`): written when absent (the original) and when this
     manager's map was replaced (incoming topics, :meth:`set_navmap`; the original keeps the old
@@ -73,7 +75,8 @@ class NavMapMapsManager(MapsManagerBase):
     PARAMETERS = (
         Param("package", "", "package holding the map files (empty: the files are paths)"),
         Param("occmap_path_file", "", "map_server YAML converted to a NavMap"),
-        Param("navmap_path_file", "", ".navmap file (loaded after occmap_path_file)"),
+        Param("navmap_path_file", "",
+              ".navmap file, or a .ply/.obj mesh (loaded after occmap_path_file)"),
         Param("filters", [], "NavMap filter aliases, applied in this order", type="str[]"),
     )
     TOPICS = (
@@ -117,7 +120,7 @@ class NavMapMapsManager(MapsManagerBase):
         self._last = None
         for parameter, loader in (
             ("occmap_path_file", lambda p: navmap_from_map_yaml(p, frame)),
-            ("navmap_path_file", load_navmap),
+            ("navmap_path_file", _load_navmap_or_mesh),
         ):
             name = getattr(self.params, parameter)
             if not name:
@@ -351,3 +354,10 @@ class NavMapMapsManager(MapsManagerBase):
         log = self.logger.info if response.success else self.logger.error
         log(f"{self.plugin_name}: savemap: {response.message}")
         return response
+
+
+def _load_navmap_or_mesh(path: Path) -> NavMap:
+    """A ``.navmap`` file, or a PLY/OBJ mesh by its suffix."""
+    if Path(path).suffix.lower() in (".ply", ".obj"):
+        return navmap_from_mesh_file(path)
+    return load_navmap(path)
