@@ -304,6 +304,9 @@ class WorldDescription:
             if terrain is not None:
                 raise ValueError(f"{path}: a world has a terrain or levels, not both")
             MultiLevelWorld.from_dict(levels, f"{path}: levels")  # ValueError: malformed
+            # Named after the description, not after its ground floor's map.
+            world = World(world.occupied, world.resolution, world.origin_x, world.origin_y,
+                          name=path.stem)
         return cls(
             world,
             map_path=map_path,

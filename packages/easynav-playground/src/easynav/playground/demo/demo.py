@@ -404,6 +404,7 @@ def _run(
             f"{sum(w.reached for w in results)}/{len(results)} waypoints, "
             f"{len(truth.collisions)} collision(s), {summary.final_state}",
             terrain=description.make_terrain(),
+            levels=description.make_levels(),
         )
         print(f"picture: {Path(output_png).resolve()}", file=out)
     if code == EXIT_INTERRUPTED:

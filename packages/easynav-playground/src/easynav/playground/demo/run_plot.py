@@ -10,6 +10,7 @@ import numpy as np
 
 from easynav.playground.demo.waypoint_result import WaypointResult
 from easynav.playground.sim.moving_obstacle import MovingObstacle
+from easynav.playground.sim.multilevel import MultiLevelWorld
 from easynav.playground.sim.terrain import Terrain
 from easynav.playground.sim.world import World
 
@@ -27,11 +28,14 @@ def plot_run(
     title: str = "",
     progress_legend: bool = True,
     terrain: Terrain | None = None,
+    levels: MultiLevelWorld | None = None,
 ) -> None:
     """Draw the world, moving-obstacle tracks, planned paths, the true and estimated
     trajectories, the waypoints (green reached, red not) and collisions; save as PNG. A world's
     ``terrain`` is drawn under them: heights in colour, contours every 0.2 m, and the ground
-    steeper than the robot climbs hatched.
+    steeper than the robot climbs hatched. A multi-level world's ``levels`` (``world`` is then
+    its ground floor's map) are outlined over it: each higher floor's area and its height, each
+    ramp hatched with an arrow up it.
 
     Any thread (matplotlib's object API with the Agg canvas, no global pyplot state).
     """
@@ -54,6 +58,8 @@ def plot_run(
     )
     if terrain is not None:
         _draw_terrain(ax, terrain)
+    if levels is not None:
+        _draw_levels(ax, levels)
     for i, o in enumerate(obstacles):
         ax.plot(
             *o.waypoints.T,
@@ -119,6 +125,35 @@ def plot_run(
     fig.savefig(str(path), bbox_inches="tight")
 
 
+_LABEL_BOX = {"fc": "white", "alpha": 0.8, "lw": 0, "pad": 1}
+
+
+def _draw_levels(ax, levels: MultiLevelWorld) -> None:
+    """Outline the higher floors and the ramps of a multi-level world on ``ax``."""
+    from matplotlib.patches import Rectangle
+
+    base = min(f.z for f in levels.floors)
+    for i, f in enumerate(f for f in levels.floors if f.z > base):
+        x0, y0, x1, y1 = f.area
+        ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ec="tab:purple", lw=2,
+                               ls="--", label="upper floor" if i == 0 else None))
+        ax.annotate(f"{f.name} ({f.z:g} m)", (0.5 * (x0 + x1), y0), ha="center", va="bottom",
+                    fontsize=8, color="tab:purple", bbox=_LABEL_BOX)
+    for i, r in enumerate(levels.ramps):
+        x0, y0, x1, y1 = r.area
+        ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ec="tab:brown",
+                               hatch="//", lw=1.2,
+                               label="ramp (arrow: up)" if i == 0 else None))
+        mid = 0.5 * (y0 + y1) if r.axis == 0 else 0.5 * (x0 + x1)
+        (fx, fy), (tx, ty) = (((r.foot, mid), (r.top, mid)) if r.axis == 0
+                              else ((mid, r.foot), (mid, r.top)))
+        ax.annotate("", (tx, ty), (fx, fy),
+                    arrowprops={"arrowstyle": "->", "color": "tab:brown", "lw": 1.5})
+        ax.annotate(f"{r.name} {math.degrees(r.slope):.1f} deg", (0.5 * (fx + tx), mid
+                    if r.axis == 0 else 0.5 * (fy + ty)), ha="center", va="bottom",
+                    fontsize=8, color="tab:brown", bbox=_LABEL_BOX)
+
+
 def _draw_terrain(ax, terrain: Terrain) -> None:
     """Heights, contours and the too-steep ground of ``terrain`` on ``ax``."""
     from easynav.maps.gridmap.grid_map import slope_layer
@@ -168,4 +203,5 @@ def plot_world(world_spec: str, path: str | Path) -> None:
         title=f"world '{description.world.name}': start, demo waypoints, moving obstacle tracks",
         progress_legend=False,
         terrain=description.make_terrain(),
+        levels=description.make_levels(),
     )
