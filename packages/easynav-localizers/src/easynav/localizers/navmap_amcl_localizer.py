@@ -4,6 +4,7 @@ corrected with 3D scans against a Bonxai voxel map (CATALOGUE §6.4)."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -48,7 +49,12 @@ SNAP_HEIGHT_EPS = 0.5
 WEIGHT_FLOOR = 1e-6
 #: inflation_stddev when the value given is not > 0 (the original's fallback).
 INFLATION_STDDEV_FALLBACK = 1.5
-#: The 13 parameters shared with the costmap AMCL (CATALOGUE §2.5), imported from it.
+#: The 13 parameters shared with the costmap AMCL (CATALOGUE §2.5), imported from it (two
+#: descriptions adapted: no KLD here, and the reseed keeps top_keep_fraction).
+_DESCRIPTIONS = {
+    "num_particles": "particle count",
+    "reseed_freq": "keep the best top_keep_fraction, redraw the others around them, this often",
+}
 _SHARED = (
     "num_particles", "initial_pose.x", "initial_pose.y", "initial_pose.yaw",
     "initial_pose.std_dev_xy", "initial_pose.std_dev_yaw", "reseed_freq", "noise_translation",
@@ -178,7 +184,8 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
 
     NEEDS_MAPS = ("navmap",)
     PARAMETERS = (
-        *(p for p in CostmapAMCLLocalizer.PARAMETERS if p.name in _SHARED),
+        *(replace(p, description=_DESCRIPTIONS.get(p.name, p.description))
+          for p in CostmapAMCLLocalizer.PARAMETERS if p.name in _SHARED),
         Param("initial_pose.z", math.nan, "height of the initial level (NaN: any level under "
               "(x, y); not in the original)", "m", allow_nan=True, dynamic=False),
         Param("inflation_stddev", 0.05, "σ of the inflated likelihood map (not > 0: 1.5, as the "
