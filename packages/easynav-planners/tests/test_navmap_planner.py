@@ -162,7 +162,7 @@ def diagnostic(nav_state) -> DiagnosticStatus:
     return status
 
 
-def planner_cells(planner, navmap, nav_state):
+def planner_cells(planner):
     """The NavCels of the planner's last search."""
     return planner._last_cells
 
@@ -211,7 +211,7 @@ def test_two_floors_path_climbs_the_ramp_and_costs_what_dijkstra_says():
     on_ramp = (pts[:, 0] > 5.2) & (pts[:, 0] < 8.8) & (pts[:, 2] > 0.05)
     assert (pts[on_ramp, 1] > 2.0).all()
     np.testing.assert_allclose(pts[on_ramp, 2], 1.5 * (9 - pts[on_ramp, 0]) / 4, atol=1e-9)
-    cells = planner_cells(planner, navmap, nav_state)
+    cells = planner_cells(planner)
     mult = step_multipliers(None, navmap.num_navcels, 2.0, 5.0)
     expected = dijkstra_cost(navmap, mult, int(cells[0]), int(cells[-1]))
     assert path_cost(navmap.centroids, mult, cells) == pytest.approx(expected, rel=1e-9)
@@ -382,7 +382,6 @@ def test_robot_just_off_the_mesh_starts_from_the_nearest_navcel_far_off_fails():
 
 def test_no_navmap_yet():
     planner = make_planner()
-    nav_state = state_with(merge(patch(0, 1, 0, 1)), (0.5, 0.5, 0.0))
     nav_state = NavState()
     nav_state.set("robot_pose", Odometry(Header(3.0, "map"), "base_footprint", Pose()))
     nav_state.set("goals", Goals(Header(5.0, "map"), [PoseStamped(Header(5.0, "map"),
