@@ -309,3 +309,30 @@ def test_the_mesh_joins_the_floors_through_the_ramp(levels, description):
 
     start = vertex_near(*description.start_pose[:2], 0.0)
     assert find(start) == find(vertex_near(6.5, 4.4, 1.5))  # the upper waypoint
+
+
+# ---------------------------------------------------------------------- the demo's verdict
+def test_a_waypoint_reached_on_another_level_is_not_reached(description):
+    from easynav.playground.demo.run_summary import RunSummary
+    from easynav.playground.demo.waypoint_result import WaypointResult
+    from easynav.playground.world_description import load_waypoint_levels
+
+    levels = load_waypoint_levels(description.waypoints_path)
+    assert levels == ["upper", "ground", "ground"]
+    assert load_waypoint_levels(WORLDS_DIR / "home.waypoints.yaml") is None
+    truth = GroundTruthRecorder()
+    for i in range(30):  # the robot stays on the ground floor (a 2D stack)
+        truth.record_true(0.1 * i, 1.0 + 0.2 * i, 1.0, 0.0)
+        truth.record_level(0.1 * i, "ground", 0.0, 0.0)
+    results = [WaypointResult(1, 6.5, 4.4, 0.0, reached_at=1.0, level="upper"),
+               WaypointResult(2, 4.0, 1.2, 0.0, reached_at=2.0, level="ground")]
+    summary = RunSummary.compute(results, truth, "NAVIGATION_FINISHED", "", 0.0, 2.9, 10.0)
+    assert [w.arrival_level for w in results] == ["ground", "ground"]
+    assert not results[0].achieved and results[1].achieved
+    assert not summary.success and summary.to_dict()["reached_on_wrong_level"] == 1
+    table = summary.format_table()
+    assert "LEVEL" in table and "waypoints reached:    1 of 2" in table
+    assert "waypoint 1 reached on level ground, not on its level upper" in table
+    # Flat worlds: no level samples, nothing changes.
+    flat = [WaypointResult(1, 6.5, 4.4, 0.0, reached_at=1.0)]
+    assert RunSummary.compute(flat, GroundTruthRecorder(), "X", "", 0.0, 1.0, 0.0).all_reached

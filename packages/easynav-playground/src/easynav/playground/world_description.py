@@ -360,6 +360,27 @@ def _robot_entries(data: object, path: Path) -> list[RobotEntry]:
     return entries
 
 
+def load_waypoint_levels(path: str | Path) -> list[str] | None:
+    """The level of each waypoint of a multi-level world's waypoint file (its ``levels``: a
+    list of level names beside ``waypoints``), None when the file gives none.
+
+    Raises:
+        FileNotFoundError: no such file.
+        ValueError: ``levels`` is not a list of names, one per waypoint.
+    """
+    path = Path(path)
+    data = yaml.safe_load(path.read_text())
+    if not isinstance(data, dict) or data.get("levels") is None:
+        return None
+    levels = data["levels"]
+    count = len(data.get("waypoints") or [])
+    if not (isinstance(levels, list) and len(levels) == count
+            and all(isinstance(v, str) for v in levels)):
+        raise ValueError(f"{path}: levels must be a list of {count} level names, one per "
+                         f"waypoint, got {levels!r}")
+    return list(levels)
+
+
 def load_waypoints(path: str | Path) -> list[tuple[float, float, float]]:
     """Read a waypoint list: a YAML list of ``[x, y, yaw]`` (or ``{waypoints: [...]}``).
 

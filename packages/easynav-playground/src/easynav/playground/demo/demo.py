@@ -35,7 +35,11 @@ from easynav.playground.demo.run_summary import RunSummary
 from easynav.playground.demo.waypoint_result import WaypointResult
 from easynav.playground.reachability import reachable_from
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
-from easynav.playground.world_description import WorldDescription, load_waypoints
+from easynav.playground.world_description import (
+    WorldDescription,
+    load_waypoint_levels,
+    load_waypoints,
+)
 
 EXIT_SUCCESS = 0
 EXIT_FAILURE = 1
@@ -113,10 +117,13 @@ def run_demo(
             if description.waypoints_path is None:
                 raise DemoError(f"world {world!r} has no default waypoints: pass --waypoints")
             waypoint_list = load_waypoints(description.waypoints_path)
+            waypoint_levels = load_waypoint_levels(description.waypoints_path)
         elif isinstance(waypoints, str | Path):
             waypoint_list = load_waypoints(waypoints)
+            waypoint_levels = load_waypoint_levels(waypoints)
         else:
             waypoint_list = [tuple(float(v) for v in w) for w in waypoints]
+            waypoint_levels = None
         if not (math.isfinite(speed_up) and speed_up > 0):
             raise DemoError(f"speed-up must be > 0, got {speed_up}")
         params_path = Path(params_file) if params_file else DEFAULT_PARAMS
@@ -215,6 +222,7 @@ def run_demo(
             timeout,
             ready_timeout,
             out,
+            waypoint_levels,
         )
     finally:
         print(f"  logs: {run_path}", file=out)
@@ -232,6 +240,7 @@ def _run(
     timeout,
     ready_timeout,
     out,
+    waypoint_levels=None,
 ) -> int:
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
@@ -242,6 +251,8 @@ def _run(
     from easynav.playground.demo.run_monitor import RunMonitor
 
     results = [WaypointResult(i, *w) for i, w in enumerate(waypoint_list, 1)]
+    for w, level in zip(results, waypoint_levels or [], strict=False):
+        w.level = level  # a multi-level world: reached on another level is not reached
     context = rclpy.Context()
     saved_range = os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE")
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
@@ -401,7 +412,7 @@ def _run(
             truth.collisions,
             description.make_obstacles(),
             title=f"EasyNav playground demo: {description.world.name}, "
-            f"{sum(w.reached for w in results)}/{len(results)} waypoints, "
+            f"{sum(w.achieved for w in results)}/{len(results)} waypoints, "
             f"{len(truth.collisions)} collision(s), {summary.final_state}",
             terrain=description.make_terrain(),
             levels=description.make_levels(),

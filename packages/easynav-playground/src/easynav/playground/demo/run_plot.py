@@ -86,7 +86,7 @@ def plot_run(
     if start_pose is not None:
         ax.plot(*start_pose[:2], marker="s", color="tab:blue", ms=9, ls="none", label="start")
     for w in waypoints:
-        color = "tab:green" if w.reached else "tab:red"
+        color = "tab:green" if w.achieved else "tab:red"
         ax.plot(w.x, w.y, marker="o", ms=13, color=color, mec="black", ls="none")
         ax.annotate(
             str(w.index),

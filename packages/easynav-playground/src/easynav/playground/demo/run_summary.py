@@ -43,8 +43,8 @@ class RunSummary:
 
     @property
     def all_reached(self) -> bool:
-        """Every waypoint reached."""
-        return all(w.reached for w in self.waypoints)
+        """Every waypoint reached (on its own level, on a multi-level world)."""
+        return all(w.achieved for w in self.waypoints)
 
     @property
     def success(self) -> bool:
@@ -77,6 +77,7 @@ class RunSummary:
             at = truth.true_pose_at(w.reached_at)
             if at is not None:
                 w.arrival_error = math.hypot(at[0] - w.x, at[1] - w.y)
+            w.arrival_level = truth.level_at(w.reached_at)
             previous = w.reached_at
         in_run = [c for c in truth.clearances if nav_start <= c[0] <= nav_end]
         errors = truth.localisation_errors()
@@ -106,7 +107,8 @@ class RunSummary:
 
         return {
             "waypoints": len(self.waypoints),
-            "reached": sum(w.reached for w in self.waypoints),
+            "reached": sum(w.achieved for w in self.waypoints),
+            "reached_on_wrong_level": sum(w.reached and not w.on_level for w in self.waypoints),
             "final_state": self.final_state,
             "status_message": self.status_message,
             "navigation_time": clean(self.nav_end - self.nav_start),
@@ -136,10 +138,14 @@ class RunSummary:
         for w in self.waypoints:
             lines.append(
                 f"{w.index:2d} {w.x:6.2f} {w.y:6.2f} {w.yaw:6.2f}  "
-                f"{'yes' if w.reached else 'NO':>7}  {num(w.leg_time, '8.1f'):>8}  "
+                f"{_reached_cell(w):>7}  {num(w.leg_time, '8.1f'):>8}  "
                 f"{num(w.leg_distance, '9.2f'):>9}  {num(w.arrival_error, '6.3f'):>6}"
             )
-        reached = sum(w.reached for w in self.waypoints)
+        reached = sum(w.achieved for w in self.waypoints)
+        lines += [
+            f"  waypoint {w.index} reached on level {w.arrival_level}, not on its level {w.level}"
+            for w in self.waypoints if w.reached and not w.on_level
+        ]
         lines += [
             "",
             f"result:               {self.final_state}"
@@ -175,3 +181,10 @@ class RunSummary:
             )
         lines.append(f"verdict:              {'SUCCESS' if self.success else 'FAILURE'}")
         return "\n".join(lines)
+
+
+def _reached_cell(w: WaypointResult) -> str:
+    """The table's ``reached`` cell: yes, NO, or LEVEL (reached on another level)."""
+    if not w.reached:
+        return "NO"
+    return "yes" if w.on_level else "LEVEL"

@@ -52,6 +52,18 @@ class GroundTruthRecorder:
         """Add the level, height ``z`` (m) and pitch (rad) of the robot at ``stamp``."""
         self.levels.append((float(stamp), str(level), float(z), float(pitch)))
 
+    def level_at(self, stamp: float) -> str | None:
+        """The level of the latest sample at or before ``stamp`` (the first one before them
+        all); None without level samples (a world without levels)."""
+        if not self.levels:
+            return None
+        found = self.levels[0][1]
+        for t, level, _, _ in self.levels:
+            if t > stamp:
+                break
+            found = level
+        return found
+
     def max_slope(self, start: float = -math.inf, end: float = math.inf) -> float:
         """The steepest slope (rad) under the robot between two stamps; NaN without terrain
         samples there (a flat world)."""

@@ -138,6 +138,9 @@ class Simulation:
                 raise ValueError("Simulation: a world has a terrain or levels, not both")
             self.level = start_level if start_level is not None else levels.start_level
             levels.surface(self.level)  # KeyError: an unknown level
+            for name in levels.level_names:  # every level's grids now, not in the loop
+                levels.collision_world(name)
+                levels.laser_world(name)
             self.level_events.append((0.0, self.level))
             self.laser_world = levels.laser_world(self.level)
             self.collision_world = levels.collision_world(self.level)
