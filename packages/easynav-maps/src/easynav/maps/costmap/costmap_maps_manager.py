@@ -4,17 +4,14 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
-from typing import Any
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError, Topic
-from easynav.core.plugins.declarations import ParameterValueError
-from easynav.core.plugins.discovery import load_plugin_class
+from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D
-from easynav.maps.costmap.costmap_filter import COSTMAP_FILTER, CostmapFilter
+from easynav.maps.costmap.costmap_filter import COSTMAP_FILTER
 from easynav.maps.costmap.keys import MAP, MAP_BASE, MAP_OBSTACLE_BOUNDS, MAP_TIME
 from easynav.maps.costmap_io import (
     costmap_from_occupancy_grid,
@@ -22,6 +19,7 @@ from easynav.maps.costmap_io import (
     load_costmap_yaml,
     save_costmap_yaml,
 )
+from easynav.maps.filtered_maps_manager import FilteredMapsManager
 from easynav.maps.map_file_resolver import resolve_map_file
 from easynav.maps.map_format_error import MapFormatError
 from easynav.maps.occupancy_grid import OccupancyGrid
@@ -30,7 +28,7 @@ from easynav.maps.occupancy_grid import OccupancyGrid
 DEFAULT_SAVE_PATH = str(Path(tempfile.gettempdir()) / "easynav_costmap.yaml")
 
 
-class CostmapMapsManager(MapsManagerBase):
+class CostmapMapsManager(FilteredMapsManager):
     """Loads a map_server map as the static :class:`Costmap2D` and runs its filters on a copy.
 
     Parameters (under ``<alias>.``): see ``PARAMETERS``; with ``package`` empty,
@@ -85,17 +83,14 @@ class CostmapMapsManager(MapsManagerBase):
     PROVIDES_MAPS = ("costmap",)
 
     SUB_PLUGIN_LISTS = {"filters": COSTMAP_FILTER}
-
-    def sub_plugins(self) -> list:
-        """The loaded filters (runtime parameter changes of ``<alias>.<filter>.*`` go to them)."""
-        return [instance for _, instance in self._filters]
+    FILTER_KIND = COSTMAP_FILTER
+    FILTER_EXAMPLE = "easynav_costmap_maps_manager/CostmapMapsManager/InflationFilter"
 
     def __init__(self) -> None:
         super().__init__()
         self._base: Costmap2D | None = None
         self._map_file: Path | None = None
         self._save_path = DEFAULT_SAVE_PATH
-        self._filters: list[tuple[str, CostmapFilter]] = []
         self._throttle = WarningThrottle(period=5.0)
         self._ros = PluginEndpoints()
 
@@ -145,92 +140,15 @@ class CostmapMapsManager(MapsManagerBase):
         if self.context.node is not None:
             self._create_ros()
 
-    def _load_filters(self, aliases: list[str]) -> list[tuple[str, CostmapFilter]]:
-        node = self.context.node_name or "maps_manager_node"
-        if len(set(aliases)) != len(aliases):
-            raise PluginConfigurationError(
-                f"{self.plugin_name}.filters = {aliases}: an alias is listed twice (each names "
-                f"its own parameters, {self.plugin_name}.<filter>.*)"
-            )
-        loaded: list[tuple[str, CostmapFilter]] = []
-        try:
-            for alias in aliases:
-                parameter = f"{node}.{self.plugin_name}.{alias}.plugin"
-                name = self.get_parameter(f"{alias}.plugin", "", "costmap filter plugin name")
-                if not isinstance(name, str) or not name:
-                    raise PluginConfigurationError(
-                        f"{parameter} is not set: every filter alias needs a plugin name, e.g. "
-                        "easynav_costmap_maps_manager/CostmapMapsManager/InflationFilter"
-                    )
-                try:
-                    cls = load_plugin_class(COSTMAP_FILTER, name, parameter)
-                except (LookupError, ImportError) as exc:
-                    raise PluginConfigurationError(str(exc)) from None
-                instance = cls()
-                try:
-                    instance.initialize(self.context, f"{self.plugin_name}.{alias}")
-                except PluginConfigurationError:
-                    raise
-                except Exception as exc:
-                    raise PluginConfigurationError(
-                        f"{parameter} ({name}): {type(exc).__name__}: {exc}"
-                    ) from exc
-                self.logger.info(f"{self.plugin_name}: loaded costmap filter {alias} [{name}]")
-                loaded.append((alias, instance))
-        except Exception:
-            for _, instance in loaded:
-                instance.on_cleanup()
-            raise
-        return loaded
-
     def on_cleanup(self) -> None:
         self._destroy_ros()
         self._cleanup_filters()
-
-    def _cleanup_filters(self) -> None:
-        filters, self._filters = self._filters, []
-        for alias, instance in filters:
-            try:
-                instance.on_cleanup()
-            except Exception as exc:  # one filter's failure must not keep the others alive
-                self.logger.warning(f"{self.plugin_name}.{alias}: on_cleanup failed: {exc}")
-
-    # -- runtime parameter changes reach the filters ------------------------------------------
-    def _filter_for(self, name: str) -> tuple[CostmapFilter, str] | None:
-        for alias, instance in self._filters:
-            if name.startswith(alias + "."):
-                return instance, name[len(alias) + 1 :]
-        return None
-
-    def validate_parameter(self, name: str, value: Any) -> Any:
-        """A runtime change of ``<alias>.<name>``; ``<filter>.<param>`` goes to that filter."""
-        target = self._filter_for(name)
-        if target is not None:
-            return target[0].validate_parameter(target[1], value)
-        if name == "filters" or name.endswith(".plugin"):
-            raise ParameterValueError(
-                f"{self.plugin_name}.{name}: cannot change at runtime (reconfigure instead)"
-            )
-        return super().validate_parameter(name, value)
-
-    def apply_parameter(self, name: str, value: Any) -> None:
-        """Store a validated runtime change (in the filter it belongs to)."""
-        target = self._filter_for(name)
-        if target is not None:
-            target[0].apply_parameter(target[1], value)
-            return
-        super().apply_parameter(name, value)
 
     # -- public API ---------------------------------------------------------------------------
     @property
     def base_map(self) -> Costmap2D | None:
         """The static costmap in use (None until one is loaded or received)."""
         return self._base
-
-    @property
-    def filters(self) -> list[tuple[str, CostmapFilter]]:
-        """The loaded filters ``(alias, filter)`` in order."""
-        return list(self._filters)
 
     @property
     def save_path(self) -> str:

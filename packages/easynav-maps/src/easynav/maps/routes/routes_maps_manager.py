@@ -4,24 +4,22 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
-from typing import Any
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError, Topic
-from easynav.core.plugins.declarations import ParameterValueError
-from easynav.core.plugins.discovery import load_plugin_class
+from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.tf import get_tf_buffer
+from easynav.maps.filtered_maps_manager import FilteredMapsManager
 from easynav.maps.map_file_resolver import resolve_map_file
 from easynav.maps.map_format_error import MapFormatError
-from easynav.maps.routes.routes_filter import ROUTES_FILTER, RoutesFilter
+from easynav.maps.routes.routes_filter import ROUTES_FILTER
 from easynav.maps.routes.routes_map import ROUTES, RoutesMap, load_routes_yaml, save_routes_yaml
 
 #: Where save_routes writes when no routes file is configured (the original: /tmp/routes.yaml).
 DEFAULT_ROUTES_PATH = str(Path(tempfile.gettempdir()) / "routes.yaml")
 
 
-class RoutesMapsManager(MapsManagerBase):
+class RoutesMapsManager(FilteredMapsManager):
     """Holds route segments, writes them to NavState ``routes`` and runs its routes filters.
 
     ``package`` + ``map_path_file`` name the routes YAML (the original's format, see
@@ -61,16 +59,14 @@ class RoutesMapsManager(MapsManagerBase):
     NEEDS_MAPS = ("costmap",)
 
     SUB_PLUGIN_LISTS = {"filters": ROUTES_FILTER}
-
-    def sub_plugins(self) -> list:
-        """The loaded filters (runtime parameter changes of ``<alias>.<filter>.*`` go to them)."""
-        return [instance for _, instance in self._filters]
+    FILTER_KIND = ROUTES_FILTER
+    FILTER_EXAMPLE = "easynav_routes_maps_manager/RoutesCostmapFilter"
+    RUNTIME_FIXED = ("package", "map_path_file")
 
     def __init__(self) -> None:
         super().__init__()
         self._routes = RoutesMap.default()
         self._path = DEFAULT_ROUTES_PATH
-        self._filters: list[tuple[str, RoutesFilter]] = []
         self._ros = PluginEndpoints()
 
     # -- configuration ------------------------------------------------------------------------
@@ -120,66 +116,9 @@ class RoutesMapsManager(MapsManagerBase):
         self.logger.info(f"{self.plugin_name}: loaded {len(routes)} route segments from {path}")
         return routes
 
-    def _load_filters(self, aliases: list[str]) -> list[tuple[str, RoutesFilter]]:
-        node = self.context.node_name or "maps_manager_node"
-        if len(set(aliases)) != len(aliases):
-            raise PluginConfigurationError(
-                f"{self.plugin_name}.filters = {aliases}: an alias is listed twice"
-            )
-        loaded: list[tuple[str, RoutesFilter]] = []
-        try:
-            for alias in aliases:
-                parameter = f"{node}.{self.plugin_name}.{alias}.plugin"
-                name = self.get_parameter(f"{alias}.plugin", "", "routes filter plugin name")
-                if not isinstance(name, str) or not name:
-                    raise PluginConfigurationError(
-                        f"{parameter} is not set: every filter alias needs a plugin name, e.g. "
-                        "easynav_routes_maps_manager/RoutesCostmapFilter"
-                    )
-                try:
-                    cls = load_plugin_class(ROUTES_FILTER, name, parameter)
-                except (LookupError, ImportError) as exc:
-                    raise PluginConfigurationError(str(exc)) from None
-                instance = cls()
-                instance.initialize(self.context, f"{self.plugin_name}.{alias}")
-                loaded.append((alias, instance))
-        except Exception:
-            for _, instance in loaded:
-                instance.on_cleanup()
-            raise
-        return loaded
-
     def on_cleanup(self) -> None:
         self._destroy_ros()
         self._cleanup_filters()
-
-    def _cleanup_filters(self) -> None:
-        filters, self._filters = self._filters, []
-        for alias, instance in filters:
-            try:
-                instance.on_cleanup()
-            except Exception as exc:  # one filter's failure must not keep the others alive
-                self.logger.warning(f"{self.plugin_name}.{alias}: on_cleanup failed: {exc}")
-
-    # -- runtime parameter changes reach the filters ------------------------------------------
-    def validate_parameter(self, name: str, value: Any) -> Any:
-        """A runtime change of ``<alias>.<name>``; ``<filter>.<param>`` goes to that filter."""
-        for alias, instance in self._filters:
-            if name.startswith(alias + "."):
-                return instance.validate_parameter(name[len(alias) + 1 :], value)
-        if name in ("filters", "package", "map_path_file") or name.endswith(".plugin"):
-            raise ParameterValueError(
-                f"{self.plugin_name}.{name}: cannot change at runtime (reconfigure instead)"
-            )
-        return super().validate_parameter(name, value)
-
-    def apply_parameter(self, name: str, value: Any) -> None:
-        """Store a validated runtime change (in the filter it belongs to)."""
-        for alias, instance in self._filters:
-            if name.startswith(alias + "."):
-                instance.apply_parameter(name[len(alias) + 1 :], value)
-                return
-        super().apply_parameter(name, value)
 
     # -- public API ---------------------------------------------------------------------------
     @property
