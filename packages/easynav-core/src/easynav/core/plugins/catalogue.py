@@ -48,4 +48,27 @@ CATALOGUE: dict[str, str] = {
     "easynav_octomap_maps_manager/OctomapMapsManager": "easynav-maps",
     "easynav_bonxai_maps_manager/BonxaiMapsManager": "easynav-maps",
     "easynav_fusion_localizer/FusionLocalizer": "easynav-localizers",
+    "easynav_costmap_maps_manager/CostmapMapsManager/ObstaclesFilter": "easynav-maps",
+    "easynav_costmap_maps_manager/CostmapMapsManager/InflationFilter": "easynav-maps",
+    "easynav_costmap_maps_manager/CostmapMapsManager/KeepoutFilter": "easynav-maps",
+    "easynav_costmap_maps_manager/CostmapMapsManager/SpeedFilter": "easynav-maps",
+    "easynav_mpc_controller/MPCController": "easynav-controllers",
+    "easynav_serest_controller/SerestController": "easynav-controllers",
+    "easynav_mhamcl_localizer/MHAMCLLocalizer": "easynav-localizers",
+    "easynav_gps_localizer/GpsLocalizer": "easynav-localizers",
+    "easynav_gtsam_localizer/GtsamLocalizer": "easynav-localizers",
+    "easynav_ompl_planner/OMPLPlanner": "easynav-planners",
+    # Routes
+    "easynav_routes_maps_manager/RoutesMapsManager": "easynav-maps",
+    "easynav_routes_maps_manager/RoutesCostmapFilter": "easynav-maps",
+    # Elevation maps
+    "easynav_gridmap_maps_manager/GridmapMapsManager": "easynav-maps",
+    "easynav_gridmap_astar_planner/GridMapAStarPlanner": "easynav-planners",
+    "easynav_gridmap_rrtstar_planner/GridMapRRTStarPlanner": "easynav-planners",
+    # NavMap stack
+    "easynav_navmap_maps_manager/NavMapMapsManager": "easynav-maps",
+    "easynav_navmap_maps_manager/NavMapMapsManager/ObstaclesFilter": "easynav-maps",
+    "easynav_navmap_maps_manager/NavMapMapsManager/InflationFilter": "easynav-maps",
+    "easynav_navmap_planner/AStarPlanner": "easynav-planners",
+    "easynav_navmap_localizer/AMCLLocalizer": "easynav-localizers",
 }
