@@ -336,3 +336,16 @@ def test_a_waypoint_reached_on_another_level_is_not_reached(description):
     # Flat worlds: no level samples, nothing changes.
     flat = [WaypointResult(1, 6.5, 4.4, 0.0, reached_at=1.0)]
     assert RunSummary.compute(flat, GroundTruthRecorder(), "X", "", 0.0, 1.0, 0.0).all_reached
+
+
+def test_the_mesh_loads_as_one_navmap_surface_with_two_floors():
+    """The NavMap stack's mesh builder (easynav-maps) reads the shipped PLY: one connected
+    surface, and the same (x, y) under the mezzanine locates two NavCels, at 0 and 1.5 m."""
+    builders = pytest.importorskip("easynav.maps.navmap.builders")
+    navmap = builders.navmap_from_mesh_file(WORLDS_DIR / "two_floors.walkable.ply")
+    assert len(navmap.surfaces) == 1
+    low = navmap.locate_navcel(np.array([6.53, 4.47, 0.0]))
+    high = navmap.locate_navcel(np.array([6.53, 4.47, 1.5]))
+    assert low is not None and high is not None and low != high
+    assert navmap.centroids[low][2] == pytest.approx(0.0)
+    assert navmap.centroids[high][2] == pytest.approx(1.5)
