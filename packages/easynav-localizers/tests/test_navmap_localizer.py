@@ -461,3 +461,57 @@ def test_map_to_odom_carries_z_and_yaw():
     ox, oy = sim.odom[0], sim.odom[1]
     assert values[0] + math.cos(yaw) * ox - math.sin(yaw) * oy == pytest.approx(pose.x)
     assert values[1] + math.sin(yaw) * ox + math.cos(yaw) * oy == pytest.approx(pose.y)
+
+
+@pytest.mark.ros
+def test_over_ros_odom_initialpose_tf_and_particles_with_height(ros):
+    from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped
+    from nav_msgs.msg import Odometry as OdometryMsg
+    from tf2_msgs.msg import TFMessage
+
+    namespace = f"navmap_amcl_ros_{next(_namespaces)}"
+    get_tf_buffer(namespace).set_transform(
+        TransformStamped(Header(0.0, "base_footprint"), "lidar",
+                         Transform(np.array([0.0, 0.0, SENSOR_HEIGHT]))), "test", is_static=True)
+    amcl = NavMapAMCLLocalizer()
+    amcl.initialize(PluginContext(parameters=DictParameters({"navmap.num_particles": 50}),
+                                  node=ros.node, namespace=namespace, now=lambda: 20.0),
+                    "navmap")
+    nav_state = NavState()
+    nav_state.set("map.navmap", NAVMAP)
+    nav_state.set("map.bonxai", VOXELS)
+    tf_messages, particles = [], []
+    ros.node.create_subscription(TFMessage, "tf", tf_messages.append, 100)
+    ros.node.create_subscription(PoseArray, "/localizer_node/navmap/particles",
+                                 particles.append, 10)
+    odom_pub = ros.node.create_publisher(OdometryMsg, "odom", 10)
+    init_pub = ros.node.create_publisher(PoseWithCovarianceStamped, "initialpose", 10)
+    init = PoseWithCovarianceStamped()
+    init.header.frame_id = "map"
+    init.pose.pose.position.x, init.pose.pose.position.y = 7.0, 4.0
+    init.pose.pose.position.z = 1.5
+    init.pose.pose.orientation.w = 1.0
+    init.pose.covariance[0] = init.pose.covariance[7] = init.pose.covariance[35] = 0.01
+    assert ros.spin_until(lambda: init_pub.get_subscription_count() > 0)
+    init_pub.publish(init)
+    assert ros.spin_until(lambda: abs(amcl.filter.estimate()[0] - 7.0) < 0.2)
+    odom = OdometryMsg()
+    odom.header.frame_id = "odom"
+    odom.header.stamp.sec = 19
+    odom.pose.pose.orientation.w = 1.0
+    assert ros.spin_until(lambda: odom_pub.get_subscription_count() > 0)
+    odom_pub.publish(odom)
+    assert ros.spin_until(lambda: amcl._odom is not None)
+    amcl.update_rt(nav_state)
+    assert ros.spin_until(lambda: tf_messages)
+    sent = tf_messages[-1].transforms[0]
+    assert (sent.header.frame_id, sent.child_frame_id) == ("map", "odom")
+    assert sent.transform.translation.z == pytest.approx(1.5)
+    points = ray_cast(VOXELS, (7.0, 4.0, 1.5 + SENSOR_HEIGHT), 0.0, np.random.default_rng(0))
+    nav_state.set("lidar", PointPerception(points, "lidar", 19.0))
+    assert ros.spin_until(lambda: amcl._ros["particles"].get_subscription_count() > 0)
+    amcl.update(nav_state)
+    assert ros.spin_until(lambda: particles)
+    heights = [p.position.z for p in particles[-1].poses]
+    assert len(heights) == 50 and np.allclose(heights, 1.5)
+    amcl.cleanup()

@@ -549,6 +549,12 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
         best = int(np.argmax(weights))
         return float(self._z[best]) if weights[best] >= 0.0 else math.nan
 
+    # -- ROS ----------------------------------------------------------------------------------
+    def _create_ros(self) -> None:
+        super()._create_ros()
+        if self.params.compute_odom_from_tf:  # odometry from TF: no odom subscription
+            self._odom_node.destroy_subscription(self._ros.pop("odom"))
+
     # -- outputs ------------------------------------------------------------------------------
     def _estimate_3d(self, estimate) -> tuple[float, np.ndarray, float]:
         """``(z, rotation 3×3, var z)`` of a planar estimate: the surface under it on the best
@@ -611,24 +617,25 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
             get_tf_buffer(self.context.namespace).set_transform(transform, self.plugin_name)
 
     def _publish_particles(self, poses, estimate, covariance, z=None) -> None:
+        """``<alias>/particles`` with each particle's height (yaw-only orientation) and
+        ``<alias>/pose`` with the estimate's z and attitude, each while subscribed."""
         particles = self._ros.get("particles")
         if particles is None:
             return
-        if particles.get_subscription_count() > 0 and z is not None:
+        if particles.get_subscription_count() > 0:
             from geometry_msgs.msg import PoseArray
 
             from easynav.core.ros.converters import header_to_msg, pose_to_msg
 
             tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
             odom = self._odom
+            heights = np.zeros(len(poses)) if z is None else np.nan_to_num(z)
             msg = PoseArray(header=header_to_msg(
                 Header(odom.header.stamp if odom else self.now(), tf_info.map_frame)))
             msg.poses = [pose_to_msg(Pose.from_xy_yaw(p[0], p[1], p[2], float(h)))
-                         for p, h in zip(poses.tolist(), np.nan_to_num(z).tolist(), strict=True)]
+                         for p, h in zip(poses.tolist(), heights.tolist(), strict=True)]
             particles.publish(msg)
-            self._publish_estimate(estimate, covariance)
-            return
-        super()._publish_particles(poses, estimate, covariance)
+        self._publish_estimate(estimate, covariance)
 
     def _publish_estimate(self, estimate, covariance) -> None:
         estimate_pub = self._ros.get("pose")
