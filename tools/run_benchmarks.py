@@ -1,12 +1,14 @@
 """Run every benchmark script of every package and write one table: docs/benchmarks.md.
 
-Usage: .venv/bin/python tools/run_benchmarks.py [--only SUBSTRING] [--output PATH]
+Usage: .venv/bin/python tools/run_benchmarks.py [--only SUBSTRING] [--output PATH] [--append]
 
 Finds ``packages/*/benchmarks/bench_*.py`` and ``benchmarks/bench_*.py``, runs each in its own
 process with ``--json`` (the project's benchmark convention: rows of figure, value, unit,
 reference, reference value, ratio, goal, met), one after the other so they do not load each
 other, and writes a Markdown table with the machine, the date and the load it ran under. A
 script that fails or times out gets a row saying so, with the tail of its output.
+``--append`` adds the run as a section of its own (its date, commit and load) at the end of the
+existing file instead of replacing it: for benchmarks added after the last complete run.
 """
 
 from __future__ import annotations
@@ -105,6 +107,10 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only scripts whose path contains this")
     parser.add_argument("--output", default=str(ROOT / "docs" / "benchmarks.md"))
+    parser.add_argument(
+        "--append", action="store_true",
+        help="add this run as a section at the end of --output instead of replacing it",
+    )
     args = parser.parse_args(argv)
     load_before = os.getloadavg()[0]
     started = datetime.now(timezone.utc)
@@ -132,9 +138,15 @@ def main(argv: list[str]) -> int:
         "(a shared machine: other processes take cores, which widens the p99 figures)",
         "- scripts: " + ", ".join(f"`{s.relative_to(ROOT)}` ({t:.0f} s)" for s, _, _, t in results),
     ]
-    text = markdown(results, header)
-    Path(args.output).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.output).write_text(text)
+    output = Path(args.output)
+    if args.append and output.exists():
+        header[0] = f"## Later run: scripts matching `{args.only or ''}`"
+        header[2] = "Run after the table above, on the same kind of machine; its own conditions:"
+        text = output.read_text().rstrip("\n") + "\n\n" + markdown(results, header)
+    else:
+        text = markdown(results, header)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text(text)
     print(f"\nwrote {args.output}")
     return 0 if all(not error for _, _, error, _ in results) else 1
 
