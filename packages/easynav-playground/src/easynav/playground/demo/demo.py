@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import TextIO
 
 from easynav.playground.demo.child_process import ChildProcess
+from easynav.playground.demo.navmap_params import goal_height, point_navmap_stack_at_world
 from easynav.playground.demo.params_patch import (
     derive_params,
     laser_scan_topics,
@@ -144,6 +145,9 @@ def run_demo(
             terrain_file=(
                 description.terrain_path.resolve() if description.terrain_path else None
             ),
+        )
+        notes = point_navmap_stack_at_world(
+            derived, description, description.map_server_yaml(run_path), notes
         )
         costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
         scan_topics = laser_scan_topics(params_path)
@@ -296,7 +300,11 @@ def _run(
         spin_until(client.manager_available, ready_timeout, "waiting for EasyNav's goal manager")
         stamp = monitor.get_clock().now().nanoseconds * 1e-9
         goals = [
-            PoseStamped(Header(stamp, "map"), Pose.from_xy_yaw(w.x, w.y, w.yaw)) for w in results
+            PoseStamped(
+                Header(stamp, "map"),
+                Pose.from_xy_yaw(w.x, w.y, w.yaw, goal_height(description, w)),  # its floor's z
+            )
+            for w in results
         ]
         client.send_goals(goals)
         spin_until(
