@@ -411,7 +411,11 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
         if scan is None:
             return
         points, origins = scan
+        navmap = nav_state.get(MAP_NAVMAP)
+        self._rt_navmap = navmap  # also for the reseed's snap before any RT cycle ran
         with self._lock:
+            if self._pending_levels:
+                self._snap(navmap, self._z)
             poses = self.filter.poses.copy()
             z = self._z.copy()
             normals = self._normals.copy()
