@@ -365,6 +365,23 @@ def test_manager_projects_the_shelf_not_the_table_onto_map(tmp_path, manager_cla
         assert nav_state.get(MAP_BONXAI) is manager.voxel_map
 
 
+def test_without_insert_perceptions_the_loaded_map_stays_as_it_is(tmp_path):
+    manager = make_manager(BonxaiMapsManager, {
+        "occmap_path_file": str(room_yaml(tmp_path)), "insert_perceptions": False,
+    })
+    nav_state = NavState()
+    manager.update(nav_state)
+    before = set(map(tuple, manager.voxel_map.occupied_centres().round(3)))
+    nav_state.set("lidar", PointPerception(shelf_and_table_cloud(), "lidar", 99.0))
+    manager.update(nav_state)
+    assert set(map(tuple, manager.voxel_map.occupied_centres().round(3))) == before
+    assert nav_state.get(MAP).cost_at(1.52, 1.52) == 0  # the shelf is not in the map
+    manager.apply_parameter("insert_perceptions", True)
+    nav_state.set("lidar", PointPerception(shelf_and_table_cloud(), "lidar", 100.0))
+    manager.update(nav_state)
+    assert nav_state.get(MAP).cost_at(1.52, 1.52) == 254
+
+
 def test_bonxai_manager_loads_a_pcd_and_saves_it(tmp_path):
     points = np.array([[1.0 + 0.3 * i, 2.0, 0.3] for i in range(5)])
     write_pcd(tmp_path / "cloud.pcd", points)

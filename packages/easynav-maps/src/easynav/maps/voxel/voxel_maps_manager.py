@@ -46,6 +46,9 @@ COMMON_PARAMETERS = (
     Param("perception_group", "",
           "NavState group of the point perceptions inserted (empty: the ungrouped ones), e.g. "
           "a 3D lidar grouped away from the 2D localizer"),
+    Param("insert_perceptions", True,
+          "insert the point perceptions into the map (false: the loaded or received map stays "
+          "as it is, as in the original Bonxai and OctoMap managers)"),
     Param("save_map_path", "", "where savemap writes (empty: the loaded file, else the temp dir)"),
     Param("publish_period", 1.0, "least time between two publications of the voxel cloud", "s",
           ge=0.0),
@@ -270,7 +273,9 @@ class VoxelMapsManager(CostmapMapsManager):
         if self._voxels is None:
             return
         self._voxels.set_band(self.params.min_z, self.get_robot_geometry().height)
-        newest = self._insert_perceptions(nav_state)
+        newest = -math.inf
+        if self.params.insert_perceptions:
+            newest = self._insert_perceptions(nav_state)
         base = self._sync_base(nav_state)
         self._after_update(nav_state)
         self._publish_cloud()
