@@ -30,6 +30,8 @@ import math
 
 import numpy as np
 
+from easynav.planners.compiled_kernel import CompiledKernel
+
 #: First blocked cost (INSCRIBED_INFLATED_OBSTACLE): cells at or above it are never entered.
 BLOCKED_COST = 253
 SQRT2 = math.sqrt(2.0)
@@ -143,25 +145,12 @@ def path_cost(
     return float(((1.0 + cost_factor * entered) * lengths).sum())
 
 
-def _compiled():
-    """The numba kernel, compiled on first use (None without numba)."""
-    global _KERNEL
-    if _KERNEL is None:
-        try:
-            from easynav.planners._costmap_astar_numba import astar_kernel
-        except ImportError:
-            _KERNEL = False
-        else:
-            _KERNEL = astar_kernel
-    return _KERNEL or None
-
-
-_KERNEL = None
+_KERNEL = CompiledKernel("easynav.planners._costmap_astar_numba", "astar_kernel")
 
 
 def compiled_available() -> bool:
     """Whether the numba-compiled search is available (``easynav-planners[numba]``)."""
-    return _compiled() is not None
+    return _KERNEL.available()
 
 
 def astar_costmap(
@@ -184,7 +173,7 @@ def astar_costmap(
     Raises:
         ValueError: ``start`` or ``goal`` off the grid, or ``costs`` not 2-D.
     """
-    kernel = _compiled()
+    kernel = _KERNEL.get()
     if kernel is None:
         path, cost = astar_costmap_reference(
             costs, start, goal, cost_factor, heuristic_scale, diagonal_cost

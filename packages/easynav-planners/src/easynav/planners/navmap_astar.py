@@ -24,6 +24,8 @@ import math
 
 import numpy as np
 
+from easynav.planners.compiled_kernel import CompiledKernel
+
 #: The original's normalisation of a cost (INSCRIBED_INFLATED_OBSTACLE).
 INSCRIBED = 253.0
 #: Costs never entered: LETHAL_OBSTACLE and NO_INFORMATION.
@@ -143,25 +145,12 @@ def path_cost(centroids: np.ndarray, mult: np.ndarray, path) -> float:
     return float((d * np.asarray(mult, dtype=np.float64)[cells[1:]]).sum())
 
 
-def _compiled():
-    """The numba kernel, compiled on first use (None without numba)."""
-    global _KERNEL
-    if _KERNEL is None:
-        try:
-            from easynav.planners._navmap_astar_numba import navmap_astar_kernel
-        except ImportError:
-            _KERNEL = False
-        else:
-            _KERNEL = navmap_astar_kernel
-    return _KERNEL or None
-
-
-_KERNEL = None
+_KERNEL = CompiledKernel("easynav.planners._navmap_astar_numba", "navmap_astar_kernel")
 
 
 def compiled_available() -> bool:
     """Whether the numba-compiled search is available (``easynav-planners[numba]``)."""
-    return _compiled() is not None
+    return _KERNEL.available()
 
 
 def astar_navmap(
@@ -182,7 +171,7 @@ def astar_navmap(
     Raises:
         ValueError: arrays of different lengths, ``start`` or ``goal`` not a NavCel id.
     """
-    kernel = _compiled()
+    kernel = _KERNEL.get()
     if kernel is None:
         path, cost = astar_navmap_reference(neighbors, centroids, mult, start, goal)
         return (None if path is None else np.asarray(path, dtype=np.int64)), cost
