@@ -191,43 +191,14 @@ def in_box(points: np.ndarray, lower, upper) -> np.ndarray:
 def zone_markers(zone: CollisionZone) -> Any:
     """The original's debug markers of ``zone``: a visualization_msgs/MarkerArray with a
     DELETEALL, the box (CUBE, id 1) and the points (SPHERE_LIST, id 2), namespace
-    ``collision_zone``. Needs visualization_msgs (ImportError otherwise)."""
-    from geometry_msgs.msg import Point
-    from visualization_msgs.msg import Marker, MarkerArray
+    ``collision_zone`` (:func:`~easynav.core.ros.collision_markers.collision_markers`). Needs
+    visualization_msgs (ImportError otherwise)."""
+    from easynav.core.ros.collision_markers import collision_markers
 
-    from easynav.core.ros.converters import time_to_msg
-
-    stamp = time_to_msg(zone.stamp)
-    colour = (1.0, 0.0, 0.0, 0.25) if zone.imminent else (0.0, 1.0, 0.0, 0.25)
-    lifetime_ns = int(MARKER_LIFETIME * 1e9)
-
-    def marker(marker_id: int, kind: int, action: int) -> Marker:
-        m = Marker()
-        m.header.frame_id = zone.frame
-        m.header.stamp = stamp
-        m.ns = "collision_zone"
-        m.id = marker_id
-        m.type = kind
-        m.action = action
-        m.pose.orientation.w = 1.0
-        return m
-
-    array = MarkerArray()
-    array.markers.append(marker(0, Marker.ARROW, Marker.DELETEALL))
-    box = marker(1, Marker.CUBE, Marker.ADD)
-    (x0, y0, z0), (x1, y1, z1) = zone.lower, zone.upper
-    box.pose.position.x, box.pose.position.y = (x0 + x1) / 2.0, (y0 + y1) / 2.0
-    box.pose.position.z = (z0 + z1) / 2.0
-    box.scale.x, box.scale.y, box.scale.z = x1 - x0, y1 - y0, max(z1 - z0, 0.0)
-    points = marker(2, Marker.SPHERE_LIST, Marker.ADD)
-    points.scale.x = points.scale.y = points.scale.z = 0.03
-    finite = zone.points[np.all(np.isfinite(zone.points), axis=1)]
-    points.points = [Point(x=float(x), y=float(y), z=float(z)) for x, y, z in finite]
-    for m in (box, points):
-        m.color.r, m.color.g, m.color.b, m.color.a = colour
-        m.lifetime.sec, m.lifetime.nanosec = divmod(lifetime_ns, 1_000_000_000)
-    array.markers.extend((box, points))
-    return array
+    return collision_markers(
+        zone.frame, zone.stamp, zone.lower, zone.upper, zone.points, zone.imminent,
+        MARKER_LIFETIME,
+    )
 
 
 def first_collision(
