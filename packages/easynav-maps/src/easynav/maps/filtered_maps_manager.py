@@ -89,6 +89,14 @@ class FilteredMapsManager(MapsManagerBase):
             raise
         return loaded
 
+    def on_cleanup(self) -> None:
+        """Release the ROS endpoints, then the filters. Configuring thread."""
+        self._destroy_ros()
+        self._cleanup_filters()
+
+    def _destroy_ros(self) -> None:
+        """Release the manager's ROS endpoints (subclasses that have some override this)."""
+
     def _cleanup_filters(self) -> None:
         filters, self._filters = self._filters, []
         for alias, instance in filters:

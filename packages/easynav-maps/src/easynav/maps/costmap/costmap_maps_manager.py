@@ -140,10 +140,6 @@ class CostmapMapsManager(FilteredMapsManager):
         if self.context.node is not None:
             self._create_ros()
 
-    def on_cleanup(self) -> None:
-        self._destroy_ros()
-        self._cleanup_filters()
-
     # -- public API ---------------------------------------------------------------------------
     @property
     def base_map(self) -> Costmap2D | None:

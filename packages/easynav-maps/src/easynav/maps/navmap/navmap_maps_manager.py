@@ -139,10 +139,6 @@ class NavMapMapsManager(FilteredMapsManager):
         if self.context.node is not None:
             self._create_ros()
 
-    def on_cleanup(self) -> None:
-        self._destroy_ros()
-        self._cleanup_filters()
-
     # -- public API ---------------------------------------------------------------------------
     @property
     def navmap(self) -> NavMap | None:

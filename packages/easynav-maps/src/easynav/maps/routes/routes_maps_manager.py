@@ -116,10 +116,6 @@ class RoutesMapsManager(FilteredMapsManager):
         self.logger.info(f"{self.plugin_name}: loaded {len(routes)} route segments from {path}")
         return routes
 
-    def on_cleanup(self) -> None:
-        self._destroy_ros()
-        self._cleanup_filters()
-
     # -- public API ---------------------------------------------------------------------------
     @property
     def routes(self) -> RoutesMap:
