@@ -17,6 +17,7 @@ import argparse
 import json
 import os
 import platform
+import signal
 import subprocess
 import sys
 import tempfile
@@ -47,22 +48,41 @@ def cpu_model() -> str:
     return platform.processor() or "unknown CPU"
 
 
+def stop_group(proc: subprocess.Popen) -> None:
+    """SIGINT to the script's process group (its children clean up), SIGKILL after 20 s."""
+    for sig, wait in ((signal.SIGINT, 20.0), (signal.SIGKILL, 5.0)):
+        try:
+            os.killpg(proc.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            proc.communicate(timeout=wait)
+            return
+        except subprocess.TimeoutExpired:
+            continue
+
+
 def run_one(script: Path) -> tuple[list[dict], str, float]:
     """The script's rows, an error text ("" when it ran), and its wall time."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "rows.json"
         start = time.monotonic()
+        # Its own process group: a script that times out is stopped with the processes it
+        # started (the whole-stack benchmark's EasyNav and playground kept running, and
+        # loading the machine, after a timeout killed only the script).
+        proc = subprocess.Popen(
+            [sys.executable, str(script), "--json", str(out)], cwd=ROOT,
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        )
         try:
-            proc = subprocess.run(
-                [sys.executable, str(script), "--json", str(out)],
-                cwd=ROOT, capture_output=True, text=True, timeout=TIMEOUT,
-            )
+            stdout, stderr = proc.communicate(timeout=TIMEOUT)
         except subprocess.TimeoutExpired:
+            stop_group(proc)
             return [], f"timed out after {TIMEOUT:.0f} s", time.monotonic() - start
         took = time.monotonic() - start
-        sys.stdout.write(proc.stdout[-4000:])
+        sys.stdout.write(stdout[-4000:])
         if proc.returncode != 0 or not out.exists():
-            tail = (proc.stderr or proc.stdout).strip().splitlines()[-3:]
+            tail = (stderr or stdout).strip().splitlines()[-3:]
             return [], f"exit {proc.returncode}: " + " / ".join(tail), took
         return json.loads(out.read_text()), "", took
 
