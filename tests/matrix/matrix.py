@@ -27,7 +27,12 @@ from pathlib import Path
 import yaml
 
 from easynav.core.cli.params_file import load_ros_yaml
-from easynav.core.plugins.compatibility import compatible, needed_maps, provided_maps
+from easynav.core.plugins.compatibility import (
+    compatible,
+    needed_maps,
+    provided_maps,
+    required_maps,
+)
 from easynav.core.plugins.discovery import list_plugins, load_plugin_class
 from easynav.core.plugins.plugin_kinds import ALL_KINDS
 
@@ -153,8 +158,9 @@ def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
         provides = {rep for m in stack for rep in provided_maps(classes[("maps manager", m)])}
         maps = "+".join(stack)
         if not all(
-            compatible(needed_maps(classes[(kind, name)]), provides)
-            for kind, name in (("localizer", loc), ("planner", plan), ("controller", ctrl))
+            compatible(needed_maps(cls), provides, required_maps(cls))
+            for cls in (classes[(kind, name)] for kind, name in
+                        (("localizer", loc), ("planner", plan), ("controller", ctrl)))
         ):
             continue
         needs = set().union(*(
@@ -192,6 +198,12 @@ def unmatched_plugins(combos: list[Combination]) -> dict[str, str]:
                 reasons[name] = (
                     f"provides {', '.join(sorted(provides)) or 'nothing'}: no installed "
                     f"{' or '.join(missing) or 'plugin'} works on it"
+                )
+            elif required_maps(cls):
+                reasons[name] = (
+                    f"needs {' or '.join(needed_maps(cls))} and {' and '.join(required_maps(cls))}"
+                    " from two maps managers: the matrix's stacks pair a maps manager only with "
+                    "one working on its map"
                 )
             elif needed_sensors(cls):
                 reasons[name] = (

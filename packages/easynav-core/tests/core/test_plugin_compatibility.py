@@ -56,6 +56,38 @@ def test_two_maps_managers_provide_together():
     }) == []
 
 
+class NavMaps(MapsManagerBase):
+    PROVIDES_MAPS = ("navmap",)
+
+
+class VoxelMaps(MapsManagerBase):
+    PROVIDES_MAPS = ("costmap", "bonxai")
+
+
+class SurfaceAndVoxelLocalizer(PlannerMethodBase):
+    NEEDS_MAPS = ("navmap",)
+    REQUIRES_MAPS = ("bonxai",)
+
+
+def test_a_plugin_that_requires_two_maps_needs_both_managers():
+    # The NavMap AMCL: predicts on the navmap, corrects on the bonxai voxels.
+    assert not compatible(("navmap",), ("navmap",), ("bonxai",))
+    assert compatible(("navmap",), ("navmap", "costmap", "bonxai"), ("bonxai",))
+    loc = ("amcl", "pkg/SurfaceAndVoxelLocalizer", SurfaceAndVoxelLocalizer)
+    assert compatibility_errors({
+        "maps_manager_node": [("navmap", "pkg/NavMaps", NavMaps)],
+        "localizer_node": [loc],
+    }) == [
+        "localizer_node.amcl [pkg/SurfaceAndVoxelLocalizer] needs maps of types bonxai, but "
+        "maps_manager_node.navmap [pkg/NavMaps] provides navmap"
+    ]
+    assert compatibility_errors({
+        "maps_manager_node": [("navmap", "pkg/NavMaps", NavMaps),
+                              ("walls", "pkg/VoxelMaps", VoxelMaps)],
+        "localizer_node": [loc],
+    }) == []
+
+
 @pytest.mark.ros
 def test_easynav_check_refuses_a_planner_without_its_map(params_file):
     document = system_params(**{

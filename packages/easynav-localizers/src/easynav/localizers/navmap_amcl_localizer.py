@@ -183,6 +183,7 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
     """
 
     NEEDS_MAPS = ("navmap",)
+    REQUIRES_MAPS = ("bonxai",)  # the correction scores on the Bonxai voxels
     PARAMETERS = (
         *(replace(p, description=_DESCRIPTIONS.get(p.name, p.description))
           for p in CostmapAMCLLocalizer.PARAMETERS if p.name in _SHARED),

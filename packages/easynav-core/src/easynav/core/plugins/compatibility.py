@@ -4,7 +4,8 @@
 manager": SimplePlanner reads a SimpleMap under NavState ``map``, CostmapPlanner a Costmap2D under
 the same key. Each maps manager declares the representations it writes (``PROVIDES_MAPS``), each
 localizer, planner or controller the representations it can work on (``NEEDS_MAPS``: any one of
-them; empty when it needs no map). A combination where a plugin needs a representation that no
+them; empty when it needs no map) and those it needs besides, every one (``REQUIRES_MAPS``). A
+combination where a plugin needs a representation that no
 loaded maps manager provides is rejected at configure time (so by ``easynav check``), naming both
 sides, instead of a planner that silently never plans.
 
@@ -30,10 +31,16 @@ def needed_maps(cls: type) -> tuple[str, ...]:
     return tuple(getattr(cls, "NEEDS_MAPS", ()))
 
 
-def compatible(needs: Iterable[str], provides: Iterable[str]) -> bool:
-    """Whether a plugin needing ``needs`` can run beside maps providing ``provides``."""
-    needs = tuple(needs)
-    return not needs or bool(set(needs) & set(provides))
+def required_maps(cls: type) -> tuple[str, ...]:
+    """The map representations a plugin class needs besides, every one of them."""
+    return tuple(getattr(cls, "REQUIRES_MAPS", ()))
+
+
+def compatible(needs: Iterable[str], provides: Iterable[str], requires: Iterable[str] = ()) -> bool:
+    """Whether a plugin needing one of ``needs`` and all of ``requires`` can run beside maps
+    providing ``provides``."""
+    needs, provides = tuple(needs), set(provides)
+    return (not needs or bool(set(needs) & provides)) and set(requires) <= provides
 
 
 def compatibility_errors(loaded: Mapping[str, Iterable[LoadedEntry]]) -> list[str]:
@@ -51,8 +58,8 @@ def compatibility_errors(loaded: Mapping[str, Iterable[LoadedEntry]]) -> list[st
     errors = []
     for node, entries in loaded.items():
         for alias, name, cls in entries:
-            needs = needed_maps(cls)
-            if compatible(needs, provided):
+            needs, requires = needed_maps(cls), required_maps(cls)
+            if compatible(needs, provided, requires):
                 continue
             if providers:
                 offer = "; ".join(
@@ -60,7 +67,9 @@ def compatibility_errors(loaded: Mapping[str, Iterable[LoadedEntry]]) -> list[st
                 )
             else:
                 offer = "no loaded maps manager provides a map"
-            errors.append(
-                f"{node}.{alias} [{name}] needs a map of type {' or '.join(needs)}, but {offer}"
-            )
+            if not compatible(needs, provided):
+                wanted = f"a map of type {' or '.join(needs)}"
+            else:
+                wanted = "maps of types " + " and ".join(r for r in requires if r not in provided)
+            errors.append(f"{node}.{alias} [{name}] needs {wanted}, but {offer}")
     return errors

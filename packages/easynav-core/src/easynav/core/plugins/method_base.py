@@ -59,6 +59,9 @@ class MethodBase(ParameterOwner):
     #: whose needs no loaded maps manager provides fails configure (see plugins.compatibility).
     PROVIDES_MAPS: ClassVar[tuple[str, ...]] = ()
     NEEDS_MAPS: ClassVar[tuple[str, ...]] = ()
+    #: Map representations needed besides it, every one of them (the NavMap AMCL predicts on
+    #: the ``navmap`` and corrects on the ``bonxai`` voxels).
+    REQUIRES_MAPS: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self) -> None:
         self.context: PluginContext = PluginContext()
