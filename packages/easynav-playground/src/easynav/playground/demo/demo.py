@@ -183,14 +183,14 @@ def run_demo(
         # The check walks the 2D map of one floor; the waypoints of a multi-level world lie on
         # several floors joined by ramps, which it cannot follow.
         print("  (multi-level world: the waypoints' reachability is not checked in 2D)", file=out)
-        starts = []
-    for i, (start, w) in enumerate(zip(starts, waypoint_list[:len(starts)], strict=True), 1):
-        if not reachable_from(description.world, start, [w[:2]], **check)[0]:
-            print(
-                f"  warning: waypoint {i} ({w[0]:.2f}, {w[1]:.2f}) looks unreachable from "
-                f"({start[0]:.2f}, {start[1]:.2f}) for {rule}",
-                file=out,
-            )
+    else:
+        for i, (start, w) in enumerate(zip(starts, waypoint_list, strict=True), 1):
+            if not reachable_from(description.world, start, [w[:2]], **check)[0]:
+                print(
+                    f"  warning: waypoint {i} ({w[0]:.2f}, {w[1]:.2f}) looks unreachable from "
+                    f"({start[0]:.2f}, {start[1]:.2f}) for {rule}",
+                    file=out,
+                )
     domain = _free_domain_id() if domain_id is None else int(domain_id)
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
     record = run_path / "ground_truth.json"
