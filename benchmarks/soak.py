@@ -339,8 +339,9 @@ def main() -> int:
     if not (math.isfinite(args.minutes) and args.minutes > 0):
         parser.error("--minutes must be > 0")
 
+    from easynav.core.testing.dds_isolation import reserve_domain
     from easynav.playground.demo.child_process import ChildProcess
-    from easynav.playground.demo.demo import _easynav_command, _free_domain_id
+    from easynav.playground.demo.demo import _easynav_command
     from easynav.playground.demo.params_patch import derive_params
     from easynav.playground.demo.run_summary import RunSummary
     from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
@@ -362,7 +363,7 @@ def main() -> int:
         robot_height=description.robot.height,
         terrain_file=description.terrain_path.resolve() if description.terrain_path else None,
     )
-    domain = _free_domain_id()
+    domain = reserve_domain(f"soak/{os.getpid()}")  # held until the soak exits
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain),
            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
     record = run_dir / "ground_truth.json"

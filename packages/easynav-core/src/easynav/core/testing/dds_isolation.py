@@ -24,13 +24,13 @@ FIRST_DOMAIN = 1
 DOMAIN_COUNT = 101
 LOCK_DIR = Path(tempfile.gettempdir()) / "easynav-ros-domains"
 
-# The open lock file of this process's domain: it must stay open for the process's lifetime.
-_held_lock = None
+# The open lock files of the domains this process holds for its lifetime: they must stay open.
+_held_locks: list = []
 
 
 def _try_lock(domain: int):
     LOCK_DIR.mkdir(parents=True, exist_ok=True)
-    handle = open(LOCK_DIR / f"domain-{domain}.lock", "a+")  # noqa: SIM115 (held until exit)
+    handle = open(LOCK_DIR / f"domain-{domain}.lock", "a+")  # noqa: SIM115 (held until released)
     try:
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
@@ -39,26 +39,60 @@ def _try_lock(domain: int):
     return handle
 
 
-def reserve_domain(seed: str) -> int:
-    """Reserve a ROS domain no other living process of this machine holds; return it.
+class DomainReservation:
+    """A ROS domain held by this process until :meth:`release` (or the end of a ``with``).
 
-    The search starts at a domain derived from ``seed`` (so concurrent runs spread out) and takes
-    the first free one. Raises RuntimeError when all are taken.
+    Thread contract: one owner thread. Raises RuntimeError (from :meth:`acquire`) when every
+    domain is held by another reservation.
     """
-    global _held_lock
-    start = int(hashlib.sha256(seed.encode()).hexdigest(), 16) % DOMAIN_COUNT
-    for offset in range(DOMAIN_COUNT):
-        domain = FIRST_DOMAIN + (start + offset) % DOMAIN_COUNT
-        handle = _try_lock(domain)
-        if handle is not None:
-            if _held_lock is not None:
-                _held_lock.close()
-            _held_lock = handle
-            return domain
-    raise RuntimeError(
-        f"every ROS domain {FIRST_DOMAIN}..{FIRST_DOMAIN + DOMAIN_COUNT - 1} is held by another "
-        f"test process (locks in {LOCK_DIR})"
-    )
+
+    def __init__(self, domain: int, handle) -> None:
+        self.domain = domain
+        self._handle = handle
+
+    @classmethod
+    def acquire(cls, seed: str) -> DomainReservation:
+        """Reserve a domain no other reservation of this machine holds.
+
+        The search starts at a domain derived from ``seed`` (so concurrent runs spread out) and
+        takes the first free one.
+        """
+        start = int(hashlib.sha256(seed.encode()).hexdigest(), 16) % DOMAIN_COUNT
+        for offset in range(DOMAIN_COUNT):
+            domain = FIRST_DOMAIN + (start + offset) % DOMAIN_COUNT
+            handle = _try_lock(domain)
+            if handle is not None:
+                return cls(domain, handle)
+        raise RuntimeError(
+            f"every ROS domain {FIRST_DOMAIN}..{FIRST_DOMAIN + DOMAIN_COUNT - 1} is held by "
+            f"another process or run (locks in {LOCK_DIR})"
+        )
+
+    def release(self) -> None:
+        """Give the domain back (its processes must have stopped: the next holder shares it)."""
+        if self._handle is not None:
+            self._handle.close()
+            self._handle = None
+
+    def __enter__(self) -> DomainReservation:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+def reserve_domain(seed: str) -> int:
+    """Reserve a ROS domain no other living process of this machine holds, for the rest of this
+    process's life; return it.
+
+    Every domain reserved this way stays held: a test process that also runs a demo on a domain
+    of its own must keep the domain its other tests use (another process taking it would hear
+    them). A run that ends before the process does uses :class:`DomainReservation` instead.
+    Raises RuntimeError when all are taken.
+    """
+    reservation = DomainReservation.acquire(seed)
+    _held_locks.append(reservation)
+    return reservation.domain
 
 
 def isolate_dds(run_id: str | None = None, worker: str | None = None) -> int:

@@ -69,11 +69,15 @@ def _easynav_command() -> list[str]:
     raise DemoError("the 'easynav' command was not found next to Python or on PATH")
 
 
-def _free_domain_id() -> int:
-    """A ROS domain id no other process of this machine holds (reserved until this one exits)."""
-    from easynav.core.testing.dds_isolation import reserve_domain
+def _domain_for_run(domain_id: int | None):
+    """The run's ROS domain: ``domain_id`` when given, else one no other process or run of this
+    machine holds, reserved until the run ends (its processes stopped). Returns a
+    DomainReservation (``.domain``; ``release()``) or None with the given id."""
+    if domain_id is not None:
+        return None
+    from easynav.core.testing.dds_isolation import DomainReservation
 
-    return reserve_domain(f"demo/{os.getpid()}")
+    return DomainReservation.acquire(f"demo/{os.getpid()}")
 
 
 def run_demo(
@@ -191,7 +195,8 @@ def run_demo(
                     f"({start[0]:.2f}, {start[1]:.2f}) for {rule}",
                     file=out,
                 )
-    domain = _free_domain_id() if domain_id is None else int(domain_id)
+    reservation = _domain_for_run(domain_id)
+    domain = reservation.domain if reservation is not None else int(domain_id)
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
     record = run_path / "ground_truth.json"
     playground_argv = [
@@ -234,6 +239,8 @@ def run_demo(
             waypoint_levels,
         )
     finally:
+        if reservation is not None:
+            reservation.release()
         print(f"  logs: {run_path}", file=out)
 
 

@@ -144,7 +144,7 @@ def run_fleet_demo(
 
     Thread contract: call from the main thread.
     """
-    from easynav.playground.demo.demo import DEFAULT_PARAMS, _free_domain_id
+    from easynav.playground.demo.demo import DEFAULT_PARAMS, _domain_for_run
 
     out = stream or sys.stdout
     try:
@@ -195,7 +195,8 @@ def run_fleet_demo(
     print(f"  params: {params_path}, one section per robot in {derived}", file=out)
     for note in notes:
         print(f"  - {note}", file=out)
-    domain = _free_domain_id() if domain_id is None else int(domain_id)
+    reservation = _domain_for_run(domain_id)
+    domain = reservation.domain if reservation is not None else int(domain_id)
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
     record = run_path / "ground_truth.json"
     playground_argv = [
@@ -226,6 +227,8 @@ def run_fleet_demo(
         return _run(description, runs, children, domain, record, output_png, timeout,
                     ready_timeout, out)
     finally:
+        if reservation is not None:
+            reservation.release()
         print(f"  logs: {run_path}", file=out)
 
 
