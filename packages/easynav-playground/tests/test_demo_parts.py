@@ -191,7 +191,7 @@ def test_derived_params_point_the_voxel_maps_managers_at_the_world(tmp_path):
 
 
 def test_the_controller_cycle_is_read_from_easynavs_log(tmp_path):
-    from easynav.playground.demo.demo import controller_cycle_from_log
+    from easynav.playground.demo.demo_run import controller_cycle_from_log
 
     log = tmp_path / "easynav.log"
     assert controller_cycle_from_log(log) is None  # no log

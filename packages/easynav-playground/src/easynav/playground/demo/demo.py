@@ -12,50 +12,42 @@ the timeout expired); 2 bad arguments; 130 interrupted (Ctrl-C).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import shutil
 import sys
 import tempfile
-import time
 from importlib import resources
 from pathlib import Path
 from typing import TextIO
 
 from easynav.playground.demo.child_process import ChildProcess
-from easynav.playground.demo.navmap_params import goal_height, point_navmap_stack_at_world
+from easynav.playground.demo.demo_run import (  # noqa: F401 (exit codes: part of this API)
+    EXIT_FAILURE,
+    EXIT_INTERRUPTED,
+    EXIT_SUCCESS,
+    EXIT_USAGE,
+    DemoError,
+    DemoRun,
+    controller_cycle_from_log,
+)
+from easynav.playground.demo.navmap_params import point_navmap_stack_at_world
 from easynav.playground.demo.params_patch import (
     derive_params,
     laser_scan_topics,
     planner_plugins,
 )
-from easynav.playground.demo.progress_line import ProgressLine
-from easynav.playground.demo.run_plot import plot_run
-from easynav.playground.demo.run_summary import RunSummary
-from easynav.playground.demo.waypoint_result import WaypointResult
 from easynav.playground.reachability import reachable_from
-from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.world_description import (
     WorldDescription,
     load_waypoint_levels,
     load_waypoints,
 )
 
-EXIT_SUCCESS = 0
-EXIT_FAILURE = 1
-EXIT_USAGE = 2
-EXIT_INTERRUPTED = 130
-
 DEFAULT_PARAMS = Path(
     str(resources.files("easynav.playground") / "params" / "playground.params.yaml")
 )
-SPIN_STEP = 0.05  # s per executor wait in the main loop
 COSTMAP_PLANNER = "easynav_costmap_planner/CostmapPlanner"
-
-
-class DemoError(Exception):
-    """A problem that ends the demo with a message (bad input, a process that died)."""
 
 
 def _easynav_command() -> list[str]:
@@ -224,223 +216,14 @@ def run_demo(
     ]
     print(f"  ROS domain {domain}; logs, params and ground truth in {run_path}", file=out)
     try:
-        return _run(
-            description,
-            waypoint_list,
-            children,
-            domain,
-            path_topic,
-            record,
-            speed_up,
-            output_png,
-            timeout,
-            ready_timeout,
-            out,
-            waypoint_levels,
-        )
+        return DemoRun(
+            description, waypoint_list, waypoint_levels, children, domain, path_topic, record,
+            output_png, timeout, ready_timeout, out,
+        ).execute()
     finally:
         if reservation is not None:
             reservation.release()
         print(f"  logs: {run_path}", file=out)
-
-
-def _run(
-    description,
-    waypoint_list,
-    children,
-    domain,
-    path_topic,
-    record,
-    speed_up,
-    output_png,
-    timeout,
-    ready_timeout,
-    out,
-    waypoint_levels=None,
-) -> int:
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-
-    from easynav.core.goals.goal_client_state import GoalClientState as S
-    from easynav.core.goals.goal_manager_client import GoalManagerClient
-    from easynav.core.types import Header, Pose, PoseStamped
-    from easynav.playground.demo.run_monitor import RunMonitor
-
-    results = [WaypointResult(i, *w) for i, w in enumerate(waypoint_list, 1)]
-    for w, level in zip(results, waypoint_levels or [], strict=False):
-        w.level = level  # a multi-level world: reached on another level is not reached
-    context = rclpy.Context()
-    saved_range = os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE")
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    try:
-        rclpy.init(context=context, domain_id=domain)
-    finally:
-        if saved_range is None:
-            os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
-        else:
-            os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = saved_range
-    executor = SingleThreadedExecutor(context=context)
-    monitor = None
-    client = None
-    progress = ProgressLine(out)
-    code = EXIT_FAILURE
-    final_state = "NOT STARTED"
-    status_message = ""
-    nav_start = nav_end = math.nan
-    try:
-        for child in children:
-            child.start()
-        monitor = RunMonitor(path_topic, context=context)
-        executor.add_node(monitor)
-        client = GoalManagerClient(monitor)
-
-        def spin_until(predicate, seconds: float, what: str) -> None:
-            deadline = time.monotonic() + seconds
-            while not predicate():
-                for child in children:
-                    if child.exit_code() is not None:
-                        raise DemoError(
-                            f"{child.name} exited with code {child.exit_code()} while {what}:\n"
-                            f"{child.log_tail()}"
-                        )
-                if time.monotonic() > deadline:
-                    raise DemoError(f"timed out after {seconds:.0f} s {what}")
-                executor.spin_once(timeout_sec=SPIN_STEP)
-
-        progress.show("waiting for the playground and EasyNav...", force=True)
-        spin_until(lambda: monitor.truth is not None, ready_timeout, "waiting for the playground")
-        spin_until(client.manager_available, ready_timeout, "waiting for EasyNav's goal manager")
-        stamp = monitor.get_clock().now().nanoseconds * 1e-9
-        goals = [
-            PoseStamped(
-                Header(stamp, "map"),
-                Pose.from_xy_yaw(w.x, w.y, w.yaw, goal_height(description, w)),  # its floor's z
-            )
-            for w in results
-        ]
-        client.send_goals(goals)
-        spin_until(
-            lambda: client.get_state() is not S.SENT_GOAL,
-            ready_timeout,
-            "waiting for the goal manager to answer",
-        )
-        nav_start = monitor.truth[0]
-        deadline = time.monotonic() + timeout
-        while True:
-            state = client.get_state()
-            feedback = client.get_feedback()
-            now = monitor.truth[0]
-            remaining = monitor.remaining_goals
-            if feedback is not None and feedback.goals.goals:
-                remaining = min(
-                    remaining if remaining is not None else 10**9, len(feedback.goals.goals)
-                )
-            if state is S.NAVIGATION_FINISHED:
-                remaining = 0
-            if remaining is not None:
-                for w in results[: len(results) - remaining]:
-                    if w.reached_at is None:
-                        w.reached_at = now
-            if state.is_terminal:
-                result = client.get_result()
-                final_state = state.name
-                status_message = result.status_message if result else ""
-                break
-            current = next((w for w in results if not w.reached), None)
-            to_go = feedback.distance_to_goal if feedback is not None else monitor.distance_to_goal
-            if to_go is None and current is not None:
-                to_go = math.hypot(current.x - monitor.truth[1], current.y - monitor.truth[2])
-            reached = sum(w.reached for w in results)
-            progress.show(
-                f"[{state.name}] waypoint {min(reached + 1, len(results))} of {len(results)}"
-                f"  to go {to_go if to_go is not None else float('nan'):5.2f} m"
-                f"  speed {monitor.speed:4.2f} m/s  t={now - nav_start:6.1f} s"
-                f"  collisions {monitor.collision_count}"
-            )
-            for child in children:
-                if child.exit_code() is not None:
-                    raise DemoError(
-                        f"{child.name} exited with code {child.exit_code()}:\n{child.log_tail()}"
-                    )
-            if time.monotonic() > deadline:
-                final_state = "TIMEOUT"
-                status_message = f"no result within {timeout:.0f} s"
-                client.cancel()
-                break
-            executor.spin_once(timeout_sec=SPIN_STEP)
-        nav_end = monitor.truth[0]
-    except DemoError as err:
-        progress.finish()
-        print(f"easynav demo: {err}", file=sys.stderr)
-        final_state = "ERROR"
-        status_message = str(err).splitlines()[0]
-    except KeyboardInterrupt:
-        progress.finish()
-        print("easynav demo: interrupted", file=sys.stderr)
-        final_state = "INTERRUPTED"
-        code = EXIT_INTERRUPTED
-        if client is not None and client.get_state().is_navigating:
-            client.cancel()
-    finally:
-        progress.finish()
-        for child in reversed(children):  # EasyNav first (it stops the robot), then the robot
-            child.stop()
-        executor.shutdown()
-        if monitor is not None:
-            monitor.destroy_node()
-        rclpy.shutdown(context=context)
-
-    try:
-        truth = GroundTruthRecorder.load(record)
-        data = json.loads(Path(record).read_text())
-        wall = data.get("wall_time")
-        rtf = data["sim_time"] / wall if wall else math.nan
-    except (OSError, ValueError, KeyError) as err:
-        print(f"easynav demo: no ground truth from the playground ({err})", file=sys.stderr)
-        truth, rtf = GroundTruthRecorder(), math.nan
-    if monitor is not None:
-        truth.estimated_poses = list(monitor.estimates.estimated_poses)
-    if math.isnan(nav_start):
-        nav_start = truth.true_poses[0][0] if truth.true_poses else 0.0
-    if math.isnan(nav_end):
-        nav_end = truth.true_poses[-1][0] if truth.true_poses else nav_start
-    summary = RunSummary.compute(
-        results,
-        truth,
-        final_state,
-        status_message,
-        nav_start,
-        nav_end,
-        monitor.command_rate(nav_start, nav_end) if monitor is not None else 0.0,
-        rtf,
-    )
-    if monitor is not None:
-        summary.late_rt_cycles = monitor.late_cycles
-    summary.controller_cycle = controller_cycle_from_log(Path(record).with_name("easynav.log"))
-    truth.save(Path(record).with_name("run.json"))  # truth + EasyNav's estimates, for analysis
-    Path(record).with_name("summary.json").write_text(json.dumps(summary.to_dict(), indent=2))
-    print(summary.format_table(), file=out)
-    if output_png:
-        plot_run(
-            output_png,
-            description.world,
-            results,
-            description.start_pose,
-            truth.true_poses,
-            truth.estimated_poses,
-            monitor.paths if monitor is not None else (),
-            truth.collisions,
-            description.make_obstacles(),
-            title=f"EasyNav playground demo: {description.world.name}, "
-            f"{sum(w.achieved for w in results)}/{len(results)} waypoints, "
-            f"{len(truth.collisions)} collision(s), {summary.final_state}",
-            terrain=description.make_terrain(),
-            levels=description.make_levels(),
-        )
-        print(f"picture: {Path(output_png).resolve()}", file=out)
-    if code == EXIT_INTERRUPTED:
-        return code
-    return EXIT_SUCCESS if summary.success else EXIT_FAILURE
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -526,26 +309,3 @@ def main(argv: list[str] | None = None) -> int:
     if args.robots > 1:
         return run_fleet_demo(world=args.world or "crossing", robots=args.robots, **common)
     return run_demo(world=args.world or "home", waypoints=args.waypoints, **common)
-
-
-def controller_cycle_from_log(log_path: Path) -> dict | None:
-    """The controller's update_rt cost from the line EasyNav's controller_node logs when it
-    is deactivated (the last one, if it was activated more than once); None when absent."""
-    from easynav.core.system.cycle_times import DESCRIPTION_PATTERN
-
-    try:
-        text = log_path.read_text(errors="replace")
-    except OSError:
-        return None
-    found = None
-    for line in text.splitlines():
-        if "controller_node" not in line:
-            continue
-        match = DESCRIPTION_PATTERN.search(line)
-        if match and match["method"] == "update_rt":
-            found = {
-                "alias": match["alias"], "plugin": match["plugin"], "runs": int(match["runs"]),
-                "median_ms": float(match["median"]), "p99_ms": float(match["p99"]),
-                "max_ms": float(match["max"]),
-            }
-    return found

@@ -28,6 +28,13 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from easynav.playground.demo.child_process import ChildProcess
+from easynav.playground.demo.demo_run import (
+    EXIT_FAILURE,
+    EXIT_INTERRUPTED,
+    EXIT_SUCCESS,
+    EXIT_USAGE,
+    SPIN_STEP,
+)
 from easynav.playground.demo.params_patch import derive_fleet_params, laser_scan_topics
 from easynav.playground.demo.progress_line import ProgressLine
 from easynav.playground.demo.run_plot import plot_run
@@ -36,11 +43,6 @@ from easynav.playground.demo.waypoint_result import WaypointResult
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 from easynav.playground.world_description import WorldDescription, load_waypoints
 
-EXIT_SUCCESS = 0
-EXIT_FAILURE = 1
-EXIT_USAGE = 2
-EXIT_INTERRUPTED = 130
-SPIN_STEP = 0.05  # s per executor wait in the main loop
 GRAPH_PERIOD = 1.0  # wall s between two looks at the ROS graph
 #: A robot's topics whose publishers must all be its own nodes (``tf``: and the playground).
 WATCHED_TOPICS = ("cmd_vel", "easynav_control", "tf")
