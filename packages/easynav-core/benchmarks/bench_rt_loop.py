@@ -6,8 +6,9 @@ Runs, one after the other for ``--duration`` seconds each, at 200 Hz:
    (the reference);
 2. the same do-nothing cycle in EasyNav's ``CycleLoop`` with an empty rclpy executor: what the
    executor's wake-ups alone cost (the loop waits in ``spin_once`` so callbacks are served);
-3. the Dummy system of the seed (params/dummy.params.yaml, on wall-clock time), whose Dummy
-   plugins busy-wait (1 ms per RT update; 10, 100 and 200 ms per non-RT update);
+3. the original EasyNav's Dummy Navigation System example (params/dummy.params.yaml, on
+   wall-clock time), whose Dummy plugins busy-wait (1 ms per RT update; 10, 100 and 200 ms
+   per non-RT update);
 4. the same without busy-waits;
 5. (3) with a GIL switch interval of 0.1 ms instead of EasyNav's 0.5 ms: the Dummy plugins'
    busy-waits are Python loops that hold the GIL, so the RT thread waits for the next switch;

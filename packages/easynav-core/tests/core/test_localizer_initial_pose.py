@@ -1,4 +1,5 @@
-"""Every localizer accepts ``initialpose`` through LocalizerMethodBase (REFERENCE.md §2)."""
+"""Every localizer accepts ``initialpose`` (PoseWithCovarianceStamped) to reset its pose, as in
+the original EasyNav, through LocalizerMethodBase."""
 
 from __future__ import annotations
 

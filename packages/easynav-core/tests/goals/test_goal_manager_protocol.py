@@ -1,5 +1,6 @@
-"""Every row of the goal-protocol table (REFERENCE.md §5), plus its seq and addressing rules,
-on the pure GoalManager (no ROS).
+"""Every row of the original EasyNav's goal-protocol table (as GoalManager's docstring lists
+it: incoming type and condition -> reply type, status text and effect), plus its seq and
+addressing rules, on the pure GoalManager (no ROS).
 """
 
 from __future__ import annotations

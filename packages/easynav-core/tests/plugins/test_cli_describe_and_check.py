@@ -31,7 +31,8 @@ def test_describe_the_simple_controller(capsys):
     assert main(["plugins", "--describe", "easynav_simple_controller/SimpleController"]) == 0
     out = capsys.readouterr().out
     row = next(line for line in out.splitlines() if line.strip().startswith("look_ahead_dist"))
-    # The original's default (CATALOGUE: 1.0); the seed's params file sets 0.2.
+    # The original SimpleController's default is 1.0; the Kobuki playground's params file
+    # (simple.params.yaml) sets 0.2.
     assert row.split()[1:4] == ["float", "1.0", "m"]
     assert any(line.strip().startswith("k_rot ") for line in out.splitlines())
     assert "cmd_vel" in out and "path" in out

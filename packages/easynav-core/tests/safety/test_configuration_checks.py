@@ -1,4 +1,5 @@
-"""configuration_errors: every check of seed-safety.txt, each error naming node/parameter."""
+"""configuration_errors: every configuration check (limits, frequencies, spin times, geometry,
+command timeouts, PLC limits, safety mode's requirements), each error naming node/parameter."""
 
 import math
 

@@ -44,8 +44,9 @@ def test_max_late_cycles_in_a_row_is_error_in_safety_mode():
 
 
 def test_outside_safety_mode_late_cycles_in_a_row_are_only_a_warn():
-    # seed-design "Real-time cycle monitoring": outside safety mode a late RT cycle is only a
-    # WARN; the status (heartbeat rt_status) still says ERROR and the message counts them.
+    # Outside safety mode a late RT cycle is only a WARN (navigation is unaffected while the
+    # components keep their frequencies); the status (heartbeat rt_status) still says ERROR and the
+    # message counts them.
     monitor = RTCycleMonitor(200.0, max_period_factor=2.0, max_late_cycles=3)
     changes = run(monitor, [0.02, 0.02, 0.02, 0.02])
     assert monitor.status == RT_ERROR and monitor.is_error

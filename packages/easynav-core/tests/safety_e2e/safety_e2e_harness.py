@@ -46,9 +46,9 @@ def _sched_fifo_allowed() -> bool:
     return try_sched_fifo()[0]
 
 
-#: Safety mode needs SCHED_FIFO (seed-safety.txt): root has it (unless a container dropped
-#: CAP_SYS_NICE), a normal user only when granted RLIMIT_RTPRIO. It is tried, as configure does,
-#: and tests that configure in safety mode are skipped, with this reason, where it is refused.
+#: Safety mode requires SCHED_FIFO (refused on configure otherwise): root has it (unless a container
+#: dropped CAP_SYS_NICE), a normal user only when granted RLIMIT_RTPRIO. It is tried, as configure
+#: does, and tests that configure in safety mode are skipped, with this reason, where it is refused.
 requires_sched_fifo = pytest.mark.skipif(
     not _sched_fifo_allowed(),
     reason=(

@@ -68,8 +68,9 @@ BASE: dict[str, Any] = {
     "recovery_node": {"recovery_manager": {"plugin": "easynav_recovery/DummyRecoveryManager"}},
 }
 
-#: What safety mode requires (seed-safety.txt "safety.mode"), with a tolerant RT monitor (a
-#: loaded test machine must not stop EasyNav in tests that are not about late cycles).
+#: What safety mode requires (plc_limits, a heartbeat period, a safety-status timeout, cmd_timeout
+#: and a keepalive > 0, real time), with a tolerant RT monitor (a loaded test machine must not stop
+#: EasyNav in tests that are not about late cycles).
 SAFETY_MODE: dict[str, Any] = {
     "system_node.safety.mode": True,
     "system_node.safety.plc_limits.max_linear_vel": 1.0,

@@ -1,8 +1,8 @@
-"""Detecting that EasyNav stopped commanding (seed-safety.txt: heartbeat, command keepalive,
-deadline and liveliness QoS): the test is a supervisor subscribed to ``easynav_heartbeat`` and a
-driver subscribed to ``cmd_vel_stamped``, both requesting a deadline, as an integrator would.
-The RT loop is blocked with the FaultyController's ``hang`` fault, switched on and off from the
-test thread.
+"""Detecting that EasyNav stopped commanding (a dead process or a blocked cycle), through the
+heartbeat, the command keepalive and their deadline and liveliness QoS: the test is a supervisor
+subscribed to ``easynav_heartbeat`` and a driver subscribed to ``cmd_vel_stamped``, both requesting
+a deadline, as an integrator would. The RT loop is blocked with the FaultyController's ``hang``
+fault, switched on and off from the test thread.
 """
 
 from __future__ import annotations
@@ -91,7 +91,7 @@ def test_blocked_rt_cycle_stops_heartbeats_fires_the_deadline_and_is_reported(ro
     assert ros.spin_until(lambda: receiver.events.deadline_missed_after(blocked_at), timeout=3.0)
     # The RT monitor sees the late cycles: LATE, then ERROR after max_late_cycles in a row;
     # the heartbeats that still get out say so. Outside safety mode the diagnostic is only a
-    # WARN (seed-design, "Real-time cycle monitoring").
+    # WARN (navigation is unaffected while the components keep their frequencies).
     assert ros.spin_until(
         lambda: any(m.rt_status == RT_ERROR for m in receiver.received_after(blocked_at)), 5.0
     )

@@ -1,7 +1,7 @@
-"""Configuration data validated and unchanged while running (seed-safety.txt "Configuration
-checks", "Safety parameters and safety mode"): a failing check leaves every node unconfigured
-and names the parameter; safety mode refuses to configure without what it requires; once
-configured in safety mode the configuration is frozen, for a node in this process and for an
+"""Configuration data validated and unchanged while running (the configuration checks of every
+configure, and safety mode's requirements and freeze): a failing check leaves every node
+unconfigured and names the parameter; safety mode refuses to configure without what it requires;
+once configured in safety mode the configuration is frozen, for a node in this process and for an
 external tool using the parameter services alike.
 """
 

@@ -1,5 +1,5 @@
-"""Controlled stop on deactivation, shutdown and unrecoverable errors (seed-safety.txt, IEC
-60204-1 row): EasyNav brakes within the deceleration limits and its last command is an exact
+"""Controlled stop on deactivation, shutdown and unrecoverable errors (a stop category in the sense
+of IEC 60204-1): EasyNav brakes within the deceleration limits and its last command is an exact
 zero, as the robot's driver (the test) receives it.
 """
 

@@ -1,6 +1,6 @@
-"""The configuration fingerprint end to end (seed-safety.txt "Configuration fingerprint"): the
-saved file, the log line, the latched ``easynav_configuration`` topic, NavState, and what
-changes the hash and what does not.
+"""The configuration fingerprint (the SHA-256 of every effective parameter, computed on each
+configure) end to end: the saved file, the log line, the latched ``easynav_configuration`` topic,
+NavState, and what changes the hash and what does not.
 """
 
 from __future__ import annotations

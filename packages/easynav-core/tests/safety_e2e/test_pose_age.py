@@ -1,6 +1,7 @@
-"""A robot pose too old or not finite (seed-safety.txt "Data age: Robot pose"), end to end: the
-FaultyLocalizer freezes its pose stamp or writes NaN; the test is the robot's driver (and the
-safety PLC in safety mode). Sensor data age is shown in tests/sensors/test_sensors_in_system.py.
+"""A robot pose too old (``system_node.safety.max_pose_age``) or not finite is an error, and in
+safety mode inhibits motion; end to end: the FaultyLocalizer freezes its pose stamp or writes NaN;
+the test is the robot's driver (and the safety PLC in safety mode). Sensor data age is shown in
+tests/sensors/test_sensors_in_system.py.
 """
 
 from __future__ import annotations

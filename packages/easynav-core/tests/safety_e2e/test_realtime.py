@@ -1,4 +1,4 @@
-"""Timing (seed-safety.txt "Real-time cycle monitoring and heartbeat", "Memory locking"): in safety
+"""Timing (late RT cycles, SCHED_FIFO, memory locking with ``safety.lock_memory``): in safety
 mode, too many late RT cycles stop ``easynav run`` with exit code 1 after braking; memory locking
 and SCHED_FIFO are refused with a clear message where they are not permitted. These run
 ``easynav`` as a user does, in a subprocess (the test is the driver and the PLC).

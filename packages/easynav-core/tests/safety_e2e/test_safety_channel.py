@@ -1,7 +1,7 @@
-"""Cooperation with the safety channel (seed-safety.txt "Safety channel status"), end to end:
-the test is the safety PLC (``easynav_safety_status``) and the robot's driver
-(``cmd_vel_stamped``); EasyNav runs in this process with a FaultyController driving at a
-constant (LINEAR_VEL, ANGULAR_VEL).
+"""Cooperation with the safety channel (protective stop, safely limited speed, no valid status
+treated as a stop), end to end: the test is the safety PLC (``easynav_safety_status``) and the
+robot's driver (``cmd_vel_stamped``); EasyNav runs in this process with a FaultyController driving
+at a constant (LINEAR_VEL, ANGULAR_VEL).
 """
 
 from __future__ import annotations

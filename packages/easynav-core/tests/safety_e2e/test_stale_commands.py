@@ -1,7 +1,8 @@
-"""No stale velocity commands, and faulty controllers contained (seed-safety.txt "Stale and
-invalid commands"), end to end: the test is the robot's driver on ``cmd_vel_stamped`` and
-scripts the FaultyController of a running EasyNav (its fault can be switched off again from
-the test thread: a plain attribute the RT thread reads every update).
+"""No stale velocity commands (only new commands proposed, ``cmd_timeout`` brakes to zero,
+non-finite commands discarded), and faulty controllers contained, end to end: the test is the
+robot's driver on ``cmd_vel_stamped`` and scripts the FaultyController of a running EasyNav (its
+fault can be switched off again from the test thread: a plain attribute the RT thread reads every
+update).
 """
 
 from __future__ import annotations

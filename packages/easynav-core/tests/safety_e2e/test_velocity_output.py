@@ -1,6 +1,6 @@
 """Velocity and acceleration limits on every command, and the velocity publisher itself (Twist or
 TwistStamped, depth 1, the deprecated parameters), as the robot's driver (the test) sees them
-(seed-design.txt "Velocity Output"; seed-safety.txt "Velocity and acceleration limits").
+(controller_node.robot_limits.* enforced by the smoother on every command, in any mode).
 """
 
 from __future__ import annotations

@@ -175,7 +175,7 @@ def test_unique_aliases_keep_the_plain_diagnostic_name(params_file, runtime_fact
 
 
 def test_the_seeds_shared_alias_gives_every_node_its_own_rate_keys(params_file, runtime_factory):
-    # The seed's simple.params.yaml calls the plugin of every node "simple".
+    # The original EasyNav's example simple.params.yaml calls the plugin of every node "simple".
     nodes = {
         "controller_node": ("controller_types", "easynav_controller/DummyController"),
         "localizer_node": ("localizer_types", "easynav_localizer/DummyLocalizer"),

@@ -14,7 +14,8 @@ class DummyLocalizer(LocalizerMethodBase):
     PARAMETERS = (
         CYCLE_TIME_RT,
         CYCLE_TIME_NORT,
-        # In the original's Dummy file (seed-design); a Dummy localizer has nothing to reseed.
+        # The original EasyNav's Dummy Navigation System example sets it on its Dummy
+        # localizer; a Dummy localizer has nothing to reseed.
         Param("reseed_freq", 1.0, "accepted for files written for AMCL; unused", "Hz", gt=0.0),
     )
 

@@ -1,4 +1,9 @@
-"""The Dummy plugins' parameters: the busy-wait of each cycle (seed-design)."""
+"""The Dummy plugins' parameters: the busy-wait of each cycle.
+
+As in the original EasyNav, ``cycle_time_rt`` / ``cycle_time_nort`` default to 0 (no delay, no
+CPU cost); when set, the plugin busy-waits (not sleeps) that long in every cycle, pinning a core,
+so that it simulates a genuinely CPU-bound slow plugin.
+"""
 
 from __future__ import annotations
 

@@ -32,7 +32,7 @@ MIN_TIME_FOR_SPEED = 0.5
 
 
 class GoalManager:
-    """Owns the mission: the goals, who commanded them, and the protocol of REFERENCE.md §5.
+    """Owns the mission: the goals, who commanded them, and the original EasyNav's goal protocol.
 
     Protocol (every reply is returned to the caller, who publishes it in order):
 

@@ -14,7 +14,7 @@ LARGEST_FINITE_DOUBLE = sys.float_info.max
 
 @dataclass(frozen=True, slots=True)
 class GoalManagerParams:
-    """system_node parameters that drive the goal manager (REFERENCE.md §1, original defaults).
+    """system_node parameters that drive the goal manager, with the original EasyNav's defaults.
 
     ``allow_preempt_goal``: a REQUEST while active replaces the mission (else it is rejected).
     ``position_tolerance`` (m, xy), ``height_tolerance`` (m, z), ``angle_tolerance`` (rad, yaw):
@@ -63,7 +63,7 @@ class GoalManagerParams:
         return cls(**dict(values))
 
 
-#: The goal manager's parameters on system_node (REFERENCE.md §1, original defaults).
+#: The goal manager's parameters on system_node, with the original EasyNav's defaults.
 GOAL_MANAGER_PARAMETERS = (
     Param("allow_preempt_goal", True, "a new goal while navigating replaces the mission"),
     Param("position_tolerance", 0.03, "a goal is reached within this distance (xy)", "m",

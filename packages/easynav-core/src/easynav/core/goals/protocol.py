@@ -1,4 +1,5 @@
-"""Names and texts of the goal-manager protocol (REFERENCE.md §4–§5).
+"""Names and texts of the goal-manager protocol: the topics, ids and reply texts of the
+original EasyNav's goal manager (goals and feedback travel on topics, no services or actions).
 
 These strings are part of the contract with the original EasyNav and its clients: tools match
 on them, so they are kept byte for byte (including the table's capitalisation).

@@ -13,7 +13,7 @@ from easynav.core.plugins.plugin_context import PluginContext
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry
 
-#: Topic every localizer listens to for a pose to reset to (REFERENCE.md §2), relative.
+#: Topic every localizer listens to for a pose to reset to (as in the original EasyNav), relative.
 INITIAL_POSE_TOPIC = "initialpose"
 
 
@@ -24,11 +24,12 @@ class LocalizerMethodBase(MethodBase):
     odometry used) and the localizer broadcasts ``map → odom``.
 
     Every localizer accepts ``initialpose`` (geometry_msgs/PoseWithCovarianceStamped, relative,
-    depth 10) through this base (REFERENCE.md §2): when hosted by a node, :meth:`initialize`
-    subscribes it on the host node; a message in the map frame (or with an empty frame) whose
-    pose and covariance are finite reaches :meth:`on_initial_pose` as an :class:`Odometry` in
-    the map frame; anything else is logged and ignored. By default :meth:`on_initial_pose`
-    continues from that pose as from a previous localizer's (:meth:`on_last_known_pose`).
+    depth 10), as in the original EasyNav, through this base: when hosted by a node,
+    :meth:`initialize` subscribes it on the host node; a message in the map frame (or with an empty
+    frame) whose pose and covariance are finite reaches :meth:`on_initial_pose` as an
+    :class:`Odometry` in the map frame; anything else is logged and ignored. By default
+    :meth:`on_initial_pose` continues from that pose as from a previous localizer's
+    (:meth:`on_last_known_pose`).
 
     Thread contract: ``update_rt`` in the RT thread, ``update`` in the non-RT thread;
     ``on_initial_pose`` in the host node's executor (the non-RT loop); ``initialize`` and

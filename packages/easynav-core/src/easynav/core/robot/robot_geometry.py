@@ -15,8 +15,8 @@ class RobotGeometry:
     to ``radius``); ``height``: top of the robot above the robot frame (m). ``user_set``: the
     fields the user configured (params file or a runtime change), whatever their value: a
     component's deprecated copy of a field (a planner's ``robot_radius``) applies only where
-    robot_geometry does not configure it (seed-design: robot_geometry takes precedence when
-    both are set).
+    robot_geometry does not configure it (as in the original EasyNav: robot_geometry takes
+    precedence when both are set).
     """
 
     radius: float = 0.3

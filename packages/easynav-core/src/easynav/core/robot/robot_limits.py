@@ -5,7 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
-# Defaults of the original EasyNav (REFERENCE.md §6).
+# Defaults of the original EasyNav's controller_node.robot_limits.* (its example params files
+# use 0.6 / -0.3 / 1.0 / 1.0 / 1.0 / 2.0 / 2.0 instead).
 DEFAULT_ROBOT_LIMITS = {
     "max_linear_vel": 0.5,
     "min_linear_vel": -0.2,

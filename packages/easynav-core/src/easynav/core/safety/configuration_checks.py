@@ -1,4 +1,5 @@
-"""Configuration checks of seed-safety.txt: every error names its parameter as node/name."""
+"""Configuration checks run on every configure, in any mode (stricter in safety mode): every
+error names its parameter as node/name, and any error fails the whole configure."""
 
 from __future__ import annotations
 
@@ -132,7 +133,7 @@ def configuration_errors(
     memlock_check: PermissionCheck = memlock_allowed,
     frequencies_in_use: Collection[tuple[str, str]] | None = None,
 ) -> list[str]:
-    """Every configuration error of seed-safety.txt, each naming its parameter (``node/name``).
+    """Every configuration error (the checks below), each naming its parameter (``node/name``).
 
     ``parameters``: the effective parameters of every EasyNav node, ``{node: {name: value}}``
     (e.g. ``{"controller_node": {"robot_limits.max_linear_vel": 0.6, ...}, "system_node":

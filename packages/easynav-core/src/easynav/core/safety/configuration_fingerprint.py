@@ -1,4 +1,6 @@
-"""ConfigurationFingerprint: the SHA-256 of every effective parameter (seed-safety.txt)."""
+"""ConfigurationFingerprint: the SHA-256 of every effective parameter of every EasyNav node,
+computed on each successful configure, so that the same fingerprint means the same
+configuration (defaults included) and a single changed parameter gives a different one."""
 
 from __future__ import annotations
 
@@ -203,7 +205,7 @@ class ConfigurationFingerprint:
         plugins: Mapping[str, Sequence[tuple[str, str]]],
         saved_path: Path | None = None,
     ) -> list[str]:
-        """The INFO log lines, as seed-safety.txt shows them::
+        """The INFO log lines, in the layout of the original EasyNav's safety documentation::
 
             Configuration SHA-256: <hash>
               (<saved path>). Plugins:

@@ -8,7 +8,9 @@ from easynav.core.safety.heartbeat_fields import HeartbeatFields
 
 
 class HeartbeatState:
-    """The heartbeat of seed-safety.txt, published from the RT cycle itself.
+    """The heartbeat (``easynav_heartbeat``, with ``safety.heartbeat.period`` > 0), published
+    from the RT cycle itself so that it stops when that cycle does: receivers that request a
+    deadline learn that EasyNav stopped commanding.
 
     Each RT cycle the node calls :meth:`poll` with ``time.monotonic()``; when it returns fields,
     the node publishes a Heartbeat with them (and a header stamped now). The first poll after

@@ -1,4 +1,5 @@
-"""ParameterFreeze: the configuration frozen in safety mode (seed-safety.txt)."""
+"""ParameterFreeze: in safety mode the configuration is frozen once configured, so the
+configuration fingerprint stays valid while EasyNav runs."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""PoseAgeCheck: a robot pose too old, or not finite, is an error (seed-safety.txt)."""
+"""PoseAgeCheck: a robot pose too old, or not finite, is an error (in any mode); in safety mode
+the robot also brakes until the pose is usable again."""
 
 from __future__ import annotations
 

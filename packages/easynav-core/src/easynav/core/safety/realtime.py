@@ -17,7 +17,7 @@ import threading
 CAP_IPC_LOCK = 14
 CAP_SYS_NICE = 23
 
-#: Priority of EasyNav's RT thread (seed-design.txt "Real-Time Execution Model").
+#: SCHED_FIFO priority of EasyNav's RT thread (the original EasyNav's, with use_real_time true).
 RT_PRIORITY = 80
 
 _RTPRIO_HELP = (
@@ -111,9 +111,10 @@ def try_sched_fifo(priority: int = RT_PRIORITY) -> tuple[bool, str]:
 def memlock_allowed() -> tuple[bool, str]:
     """Whether locking all memory is safe to ask for: ``(ok, message)``.
 
-    seed-safety.txt "Memory locking": with MCL_FUTURE and a finite RLIMIT_MEMLOCK, later
-    allocations would fail once the limit is reached, so the limit must be unlimited. A
-    process with CAP_IPC_LOCK is not bounded by RLIMIT_MEMLOCK (mlock(2)), so it qualifies too.
+    With mlockall(MCL_FUTURE) and a finite RLIMIT_MEMLOCK, later allocations would fail once
+    the limit is reached (EasyNav with ROS 2 and DDS uses hundreds of MB, so almost at once),
+    so the limit must be unlimited. A process with CAP_IPC_LOCK is not bounded by
+    RLIMIT_MEMLOCK (mlock(2)), so it qualifies too.
     """
     soft, _hard = resource.getrlimit(resource.RLIMIT_MEMLOCK)
     if soft == resource.RLIM_INFINITY:

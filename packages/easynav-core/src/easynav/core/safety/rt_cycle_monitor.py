@@ -19,7 +19,8 @@ _LEVELS = {
 
 
 class RTCycleMonitor:
-    """seed-safety.txt "Real-time cycle monitoring and heartbeat", late cycles.
+    """Detects RT cycles that start late (the heartbeat, :class:`HeartbeatState`, covers cycles
+    that do not start at all).
 
     At the start of each RT cycle the caller passes ``time.monotonic()`` (never ROS time: a
     simulation or a clock jump must not fool it). A cycle is late when it starts more than
@@ -29,10 +30,10 @@ class RTCycleMonitor:
 
     The status is reported as ``diagnostics.rt_cycle`` (hardware_id ``system_node``): WARN for
     LATE, OK when back on time; for ERROR, an ERROR diagnostic in safety mode (``safety_mode``,
-    where it stops EasyNav) and only a WARN outside it (seed-design: outside safety mode a late
-    RT cycle is only a WARN; the message and ``status`` still say ERROR). Written only on
-    changes and after the first problem. :meth:`restart` (on activation) starts over: inactive
-    time is not a late cycle.
+    where it stops EasyNav) and only a WARN outside it (outside safety mode a late RT cycle only
+    matters if the components stop keeping their frequencies, which is reported apart; the
+    message and ``status`` still say ERROR). Written only on changes and after the first
+    problem. :meth:`restart` (on activation) starts over: inactive time is not a late cycle.
 
     Thread contract: :meth:`on_cycle_start` from the RT thread only; :meth:`restart` from the
     lifecycle thread while the RT loop does not run; the read-only properties from any thread

@@ -12,7 +12,8 @@ _Status = tuple[bool, bool, float, float, str, bool, float]
 
 
 class SafetyChannelMonitor:
-    """seed-safety.txt "Safety channel status", with ``safety.status.timeout`` > 0.
+    """The safety channel's live state (protective stop, safely limited speed), read with
+    ``safety.status.timeout`` > 0 so that EasyNav does not work against the certified channel.
 
     system_node's subscription to ``easynav_safety_status`` calls :meth:`on_status` with the
     message fields and the reception time on the monotonic clock; each RT cycle reads

@@ -1,8 +1,8 @@
 """A plugin configured from one node's section of a params file, as its node would do it.
 
-The packages' tests use it to show that a section written for the original (the seed's
-``simple.params.yaml``) configures their plugin unchanged: the file goes to rclpy with
-``--params-file``, a node of the section's name reads it, and the plugin named under
+The packages' tests use it to show that a section written for the original EasyNav (the
+Kobuki playground's ``simple.params.yaml``) configures their plugin unchanged: the file goes to
+rclpy with ``--params-file``, a node of the section's name reads it, and the plugin named under
 ``<alias>.plugin`` is loaded through its entry point and initialised from that node's parameters.
 """
 

@@ -37,8 +37,9 @@ DUMMY_SYSTEM: dict[str, Any] = {
 def system_params(base: dict[str, Any] | None = None, **overrides: Any) -> dict[str, Any]:
     """A params document (``{node: {"ros__parameters": {...}}}``) on wall-clock time.
 
-    ``base`` is ``{node: params}`` (the Dummy system of the seed, without busy-waits, by
-    default); ``overrides`` maps dotted paths ``"node.a.b"`` to values (``None`` removes).
+    ``base`` is ``{node: params}`` (the original EasyNav's Dummy Navigation System example,
+    without busy-waits, by default); ``overrides`` maps dotted paths ``"node.a.b"`` to values
+    (``None`` removes).
     """
     nodes = copy.deepcopy(base if base is not None else DUMMY_SYSTEM)
     for path, value in overrides.items():
