@@ -1,10 +1,10 @@
 """Benchmark: cycle time of the RPP and MPPI controllers beside SimpleController's, one run.
 
 Each controller plugin runs its ``update_rt`` (NavState in, ``cmd_vel`` out, no ROS) on the same
-input: a 12 m path (straight, arc, straight; 0.05 m spacing), a 20 × 20 m costmap at 0.05 m
-with inflated obstacles beside the path, the robot moved along the path cycle after cycle (so
-the path tracking and the warm start work as in a run). The reference is SimpleController
-(the seed's carrot + PIDs) measured in the same run on the same input. One core: BLAS and numba
+input: a 12 m path (straight, arc, straight; 0.05 m spacing), a 20 × 20 m costmap at 0.05 m with
+inflated obstacles beside the path, the robot moved along the path cycle after cycle (so the path
+tracking and the warm start work as in a run). The reference is SimpleController (the original
+EasyNav's carrot + PIDs) measured in the same run on the same input. One core: BLAS and numba
 threads are pinned to 1 before numpy loads.
 
 Goals (issue #15): MPPI 2000 samples × 56 steps with the default critics ≤ 15 ms per cycle

@@ -341,7 +341,8 @@ def test_bad_parameter_is_named():
 
 
 def test_a_section_of_the_original_loads_unchanged():
-    # Every parameter of the original's RPP with its default (CATALOGUE §3.1).
+    # Every parameter of the original EasyNav's RPP (easynav_regulated_pp_controller, a port of
+    # Nav2's that is not parameter-compatible with it) with its default.
     original = {
         "lookahead_dist": 0.6, "min_lookahead_dist": 0.3, "max_lookahead_dist": 0.9,
         "lookahead_time": 1.5, "use_velocity_scaled_lookahead_dist": False,

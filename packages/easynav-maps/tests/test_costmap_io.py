@@ -1,4 +1,6 @@
-"""Costmap2D from map_server files and occupancy grids, and back (CATALOGUE §2.1)."""
+"""Costmap2D from map_server files and occupancy grids, and back, with the original EasyNav's
+conversions: occupancy -1 -> 255 (unknown), else round(v·254/100); back, 255 -> -1 and every
+other cost copied as is."""
 
 from __future__ import annotations
 

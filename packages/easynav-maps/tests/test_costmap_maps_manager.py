@@ -226,7 +226,8 @@ def test_inscribed_radius_parameter_is_a_deprecated_fallback(tmp_path, caplog):
     assert configured.filters[0][1].inscribed_radius() == 0.15
     plain = make_manager(base, geometry=RobotGeometry(0.4, 0.15))
     assert plain.filters[0][1].inscribed_radius() == 0.15
-    # robot_geometry set to its default value still takes precedence (seed-design).
+    # robot_geometry set to its default value still takes precedence (set is set, whatever the
+    # value, as in the original EasyNav).
     at_default = make_manager(
         dict(base, **{"inflation.inscribed_radius": 0.25}),
         geometry=RobotGeometry(user_set=frozenset({"inscribed_radius"})),

@@ -1,4 +1,6 @@
-"""Inflation against direct computations (CATALOGUE §2.4 formula)."""
+"""Inflation against direct computations of the original's (Nav2's) formula: 254 on a lethal
+cell, 253 within the inscribed radius, int(252·exp(-k·(d - inscribed))) up to the inflation
+radius."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""RoutesMapsManager and RoutesCostmapFilter without ROS (CATALOGUE §5)."""
+"""RoutesMapsManager and RoutesCostmapFilter (the original EasyNav's routes: segments from a
+YAML file; cells off every route corridor raised to ``min_cost``) without ROS."""
 
 from __future__ import annotations
 

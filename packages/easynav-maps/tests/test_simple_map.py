@@ -35,7 +35,7 @@ def test_map_file_round_trips(tmp_path):
 def test_shipped_home_map_round_trips(tmp_path):
     home = SimpleMap.load(resolve_map_file("easynav_maps", "worlds/home.map"))
     assert home.width == 280 and home.height == 200 and home.resolution == 0.05
-    assert not home.occupied_at(0.0, 0.0)  # the robot's start in the seed's example
+    assert not home.occupied_at(0.0, 0.0)  # the robot's start in the original's example
     home.save(tmp_path / "copy.map")
     assert SimpleMap.load(tmp_path / "copy.map") == home
 

@@ -18,7 +18,8 @@ from easynav.core.robot import RobotLimits
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
 
-#: The follower's parameters (defaults of the original, CATALOGUE §SimpleController).
+#: The follower's parameters (with the defaults of the original EasyNav's SimpleController,
+#: easynav_simple_controller: look_ahead_dist 1.0, tolerance_dist 0.05, k_rot 0.5, ...).
 FOLLOWER_PARAMETERS = ("look_ahead_dist", "tolerance_dist", "final_goal_angle_tolerance", "k_rot",
                        "linear_kp", "linear_ki", "linear_kd", "angular_kp", "angular_ki",
                        "angular_kd", "allow_reversing", "cusp_tolerance")

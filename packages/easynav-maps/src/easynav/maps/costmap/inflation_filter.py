@@ -99,7 +99,8 @@ class InflationFilter(CostmapFilter):
             return geometry.inscribed_radius
         name = f"{self.plugin_name}.inscribed_radius"
         # robot_geometry configures the inscribed radius when the params file sets it, or sets
-        # the radius it defaults to (seed-design: it takes precedence, whatever its value).
+        # the radius it defaults to (as in the original EasyNav, robot_geometry takes precedence
+        # over the filter's own inscribed_radius, whatever its value).
         if geometry.is_set("inscribed_radius") or geometry.is_set("radius"):
             message = (
                 f"{name} is deprecated and ignored: system_node.robot_geometry.inscribed_radius "

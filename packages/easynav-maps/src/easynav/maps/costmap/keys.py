@@ -1,4 +1,5 @@
-"""NavState keys of the costmap stack (the original's names, CATALOGUE §2.2), declared once.
+"""NavState keys of the costmap stack (the names the original EasyNav's CostmapMapsManager
+writes: ``map.base``, ``map``, ``map_time``, ``map.obstacle_bounds``), declared once.
 
 Planners, localizers and controllers that use the costmap import these constants instead of
 writing the strings.

@@ -1,4 +1,5 @@
-"""NavState keys of the NavMap stack (the original's names, CATALOGUE §6), declared once.
+"""NavState keys of the NavMap stack (the name the original EasyNav's NavMapMapsManager writes,
+``map.navmap``), declared once.
 
 Planners and localizers working on a NavMap import this constant instead of writing the string.
 """

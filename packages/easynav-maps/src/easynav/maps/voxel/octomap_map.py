@@ -17,7 +17,8 @@ from easynav.maps.voxel.voxel_rays import (
     unpack_keys,
 )
 
-#: The original's OcTree settings (CATALOGUE §7): hit 0.7, miss 0.4, clamping 0.12–0.97.
+#: The OcTree settings of the original EasyNav's OctomapMapsManager: hit 0.7, miss 0.4, clamping
+#: 0.12–0.97.
 PROB_HIT, PROB_MISS, CLAMP_MIN, CLAMP_MAX = 0.7, 0.4, 0.12, 0.97
 
 

@@ -18,7 +18,8 @@ class OctomapMapsManager(VoxelMapsManager):
     """An OctoMap ``OcTree`` (pyoctomap, ``pip install easynav-maps[octomap]``) fed by the
     point perceptions, with the 2D projection of :class:`VoxelMapsManager`.
 
-    The original's manager is a stub (no parameters, nothing updated; CATALOGUE §7); this one
+    The original EasyNav's OctomapMapsManager is a stub (no parameters, ``update`` does nothing, no
+    NavState key: it only turns an incoming point cloud into an OcTree); this one
     works under its name with the original's tree settings (resolution 0.3 m, hit 0.7, miss 0.4,
     clamping 0.12–0.97). Parameters: ``octomap_path_file`` (an OctoMap binary ``.bt``, or a
     point cloud: PCD or PLY), ``resolution`` and those of :class:`VoxelMapsManager`
