@@ -1,19 +1,32 @@
 """`make matrix`: run the whole integration matrix and write docs/matrix.md.
 
 Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depot]
-       [--speed-up 1.0] [--output docs/matrix.md] [--list]
+       [--speed-up 1.0] [--jobs 1] [--results FILE] [--output docs/matrix.md] [--list]
 
-  --slice   only the combinations that together use every plugin once (what CI runs)
-  --list    print the combinations and exit
+  --slice    only the combinations that together use every plugin once (what CI runs)
+  --jobs N   N missions at once, each in a process of its own (a mission takes about a core
+             at x1: N above the number of cores slows every run and can fail them)
+  --results  where each finished run is kept, one JSON line per run (default
+             build/matrix/results.jsonl). A later call skips the combinations already there,
+             so the full matrix (hundreds of missions, many hours) can run in parts: stop it
+             at any time and start it again. docs/matrix.md is written from the file.
+  --fresh    forget the results file first
+  --only S   only the combinations whose name contains one of the comma-separated S
+  --list     print the combinations and exit
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import platform
+import subprocess
 import sys
 import tempfile
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -22,6 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from matrix import (  # noqa: E402 (the folder is not a package)
     ROOT,
     WORLDS,
+    Outcome,
     combinations,
     covering_slice,
     markdown,
@@ -29,19 +43,76 @@ from matrix import (  # noqa: E402 (the folder is not a package)
     unmatched_plugins,
 )
 
+DEFAULT_RESULTS = ROOT / "build" / "matrix" / "results.jsonl"
+
+
+def load_results(path: Path) -> dict[str, dict]:
+    """The runs kept in ``path`` by combination name (the last line of a name wins); a line
+    cut short by a stopped run is skipped."""
+    found: dict[str, dict] = {}
+    if not path.exists():
+        return found
+    for line in path.read_text().splitlines():
+        try:
+            row = json.loads(line)
+            found[row["name"]] = row
+        except (ValueError, KeyError, TypeError):
+            continue
+    return found
+
+
+def run_one(name: str, run_dir: Path, speed_up: float, worlds: tuple[str, ...]) -> int:
+    """``--run-one``: run one combination here and print its row as one JSON line."""
+    combo = next((c for c in combinations(worlds) if c.name == name), None)
+    if combo is None:
+        print(json.dumps({"name": name, "exit_code": 2, "summary": {},
+                          "error": "no such combination"}))
+        return 2
+    outcome = run_combination(combo, run_dir, speed_up=speed_up)
+    print(json.dumps({"name": name, "exit_code": outcome.exit_code, "summary": outcome.summary,
+                      "error": outcome.error, "run_dir": str(run_dir)}))
+    return 0
+
+
+def _run_in_process(name: str, run_dir: Path, args: argparse.Namespace) -> dict:
+    """One combination in a process of its own (its own ROS domain, its own interpreter)."""
+    cmd = [sys.executable, __file__, "--run-one", name, "--run-dir", str(run_dir),
+           "--speed-up", str(args.speed_up), "--worlds", args.worlds]
+    done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ))
+    lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
+    if lines:
+        return json.loads(lines[-1])
+    tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or [f"exit {done.returncode}"]
+    return {"name": name, "exit_code": done.returncode or 1, "summary": {},
+            "error": f"the harness failed: {tail[0]}", "run_dir": str(run_dir)}
+
 
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--slice", action="store_true")
     parser.add_argument("--worlds", default=",".join(WORLDS))
     parser.add_argument("--speed-up", type=float, default=1.0)
+    parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument("--results", default=str(DEFAULT_RESULTS))
+    parser.add_argument("--fresh", action="store_true")
+    parser.add_argument("--only", default="")
     parser.add_argument("--output", default=str(ROOT / "docs" / "matrix.md"))
     parser.add_argument("--list", action="store_true")
+    parser.add_argument("--run-one", help=argparse.SUPPRESS)
+    parser.add_argument("--run-dir", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
-    combos = combinations(tuple(w for w in args.worlds.split(",") if w))
+    worlds = tuple(w for w in args.worlds.split(",") if w)
+    if args.run_one:
+        return run_one(args.run_one, Path(args.run_dir), args.speed_up, worlds)
+    if args.jobs < 1:
+        parser.error("--jobs must be >= 1")
+    combos = combinations(worlds)
     unmatched = unmatched_plugins(combos)
     if args.slice:
         combos = covering_slice(combos)
+    if args.only:
+        wanted = [part for part in args.only.split(",") if part]
+        combos = [c for c in combos if any(part in c.name for part in wanted)]
     if args.list:
         for combo in combos:
             print(combo.name)
@@ -49,16 +120,44 @@ def main(argv: list[str]) -> int:
         for name, reason in sorted(unmatched.items()):
             print(f"in no combination: {name}: {reason}")
         return 0
+
+    results_path = Path(args.results)
+    results_path.parent.mkdir(parents=True, exist_ok=True)
+    if args.fresh:
+        results_path.unlink(missing_ok=True)
+    kept = load_results(results_path)
+    todo = [c for c in combos if c.name not in kept]
+    print(f"{len(combos)} combinations: {len(combos) - len(todo)} already in {results_path}, "
+          f"{len(todo)} to run, {args.jobs} at a time", flush=True)
     started = datetime.now(timezone.utc)
-    outcomes = []
     work = Path(tempfile.mkdtemp(prefix="easynav-matrix-"))
-    for i, combo in enumerate(combos, 1):
+    lock = threading.Lock()
+    finished = [0]
+
+    def run(index_combo: tuple[int, object]) -> None:
+        i, combo = index_combo
         t0 = time.monotonic()
-        outcome = run_combination(combo, work / f"{i:03d}", speed_up=args.speed_up)
-        verdict = "green" if outcome.green else f"FAILED ({outcome.error})"
-        print(f"[{i}/{len(combos)}] {combo.name}: {verdict} ({time.monotonic() - t0:.0f} s)",
-              flush=True)
-        outcomes.append(outcome)
+        row = _run_in_process(combo.name, work / f"{i:03d}", args)
+        row["seconds"] = round(time.monotonic() - t0, 1)
+        with lock:
+            with results_path.open("a") as f:
+                f.write(json.dumps(row) + "\n")
+            kept[combo.name] = row
+            finished[0] += 1
+            green = row["exit_code"] == 0 and row["summary"].get("success")
+            verdict = "green" if green else f"FAILED ({row['error']})"
+            print(f"[{finished[0]}/{len(todo)}] {combo.name}: {verdict} ({row['seconds']:.0f} s)",
+                  flush=True)
+
+    try:
+        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            list(pool.map(run, enumerate(todo, 1)))
+    except KeyboardInterrupt:
+        print("interrupted: the finished runs are kept; run again to go on", flush=True)
+    outcomes = [
+        Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"])
+        for c in combos if c.name in kept
+    ]
     header = "\n".join([
         "# Integration matrix",
         "",
@@ -67,16 +166,18 @@ def main(argv: list[str]) -> int:
         "plugins declare it) in each world, each a waypoint mission of the playground. CI runs "
         "the slice that uses every plugin at least once (`--slice`).",
         "",
-        f"- date: {started:%Y-%m-%d %H:%M} UTC; Python {platform.python_version()}; "
-        f"speed-up x{args.speed_up:g}; runs kept in {work}",
+        f"- date: {started:%Y-%m-%d %H:%M} UTC (rows of earlier parts come from {results_path.name}"
+        f"); Python {platform.python_version()}; speed-up x{args.speed_up:g}; "
+        f"{args.jobs} run(s) at a time",
         "- this run: "
         + ("the covering slice only (`--slice`)" if args.slice else "every combination")
-        + f", worlds {args.worlds}: {len(combos)} runs",
+        + (f" whose name contains {args.only}" if args.only else "")
+        + f", worlds {args.worlds}: {len(outcomes)} of {len(combos)} runs done",
     ])
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     Path(args.output).write_text(markdown(outcomes, header, unmatched))
     print(f"wrote {args.output}")
-    return 0 if all(o.green for o in outcomes) else 1
+    return 0 if len(outcomes) == len(combos) and all(o.green for o in outcomes) else 1
 
 
 if __name__ == "__main__":
