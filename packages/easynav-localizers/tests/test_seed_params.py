@@ -1,4 +1,5 @@
-"""The seed's simple.params.yaml section for this package loads its plugin unchanged."""
+"""The original EasyNav's example simple.params.yaml (the Kobuki playground's): this package's
+section loads its plugin unchanged."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ from easynav.core.testing.params_section_plugin import plugin_from_params_sectio
 
 pytestmark = pytest.mark.ros
 
-# Verbatim from seed-design.txt (the Kobuki playground's simple.params.yaml, simplified).
+# Verbatim from the original EasyNav's documentation ("Core Design and Architecture": the
+# Kobuki playground's params/simple.params.yaml, simplified).
 SEED = """
 localizer_node:
   ros__parameters:

@@ -140,7 +140,8 @@ def test_deprecated_robot_radius_applies_where_robot_geometry_does_not_set_the_r
 
 
 def test_robot_geometry_set_to_its_default_value_still_takes_precedence():
-    # seed-design: "robot_geometry takes precedence when both are set", whatever the value.
+    # As in the original EasyNav, robot_geometry takes precedence when both are set, whatever
+    # the value.
     geometry = RobotGeometry(radius=0.3, user_set=frozenset({"radius"}))
     assert make_planner({"robot_radius": 0.7}, geometry).planner.robot_radius == 0.3
 

@@ -383,7 +383,8 @@ def test_context_without_ros_is_enough():
 
 
 def test_robot_geometry_set_to_its_default_values_still_takes_precedence():
-    # seed-design: robot_geometry takes precedence when both are set, whatever the value.
+    # As in the original EasyNav, robot_geometry takes precedence when both are set, whatever
+    # the value.
     geometry = RobotGeometry(user_set=frozenset({"radius", "height"}))
     sim = simple({"robot_radius": 0.5, "max_obstacle_z": 2.0}, geometry=geometry)
     assert sim.manager.robot_radius == 0.3

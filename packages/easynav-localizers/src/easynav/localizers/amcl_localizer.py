@@ -41,7 +41,7 @@ MIN_POINT_Z = 0.1
 
 _STATIC = {"dynamic": False}  # read at configure (the cloud is drawn then)
 
-#: Parameters (defaults of the original, CATALOGUE §AMCLLocalizer).
+#: Parameters, with the defaults of the original EasyNav's easynav_simple_localizer/AMCLLocalizer.
 AMCL_PARAMETERS = (
     Param("num_particles", 100, "number of particles", ge=1, **_STATIC),
     Param("initial_pose.x", 0.0, "initial pose: x (map frame)", "m", **_STATIC),

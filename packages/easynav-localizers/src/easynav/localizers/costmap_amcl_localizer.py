@@ -65,7 +65,8 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
 
     The odometry, prediction (RT), ``robot_pose``, ``map → odom``, ``initialpose`` and the
     particle topics are the simple AMCL's (:class:`AMCLLocalizer`, shared code); this class adds
-    the costmap, the original's parameters (CATALOGUE.md §2.5) and:
+    the costmap, the parameters of the original EasyNav's easynav_costmap_localizer (13, with its
+    defaults: noise_* 0.01, initial std_dev 0.5, min_noise_* 0.05) and:
 
     - ``sensor_model``: ``hit_count`` (the original: the fraction of the scan points that land on
       lethal (254) cells, hits and possible points accumulated across corrections until the next

@@ -1,5 +1,6 @@
 """NavMapAMCLLocalizer (easynav_navmap_localizer/AMCLLocalizer): AMCL on a NavMap surface,
-corrected with 3D scans against a Bonxai voxel map (CATALOGUE §6.4)."""
+corrected with 3D scans against a Bonxai voxel map, as the original EasyNav's: prediction on the
+NavMap (``map.navmap``), correction on the Bonxai map (``map.bonxai``)."""
 
 from __future__ import annotations
 
@@ -49,8 +50,9 @@ SNAP_HEIGHT_EPS = 0.5
 WEIGHT_FLOOR = 1e-6
 #: inflation_stddev when the value given is not > 0 (the original's fallback).
 INFLATION_STDDEV_FALLBACK = 1.5
-#: The 13 parameters shared with the costmap AMCL (CATALOGUE §2.5), imported from it (two
-#: descriptions adapted: no KLD here, and the reseed keeps top_keep_fraction).
+#: The 13 parameters shared with the costmap AMCL (the original declares the same ones with the
+#: same defaults), imported from it (two descriptions adapted: no KLD here, and the reseed keeps
+#: top_keep_fraction).
 _DESCRIPTIONS = {
     "num_particles": "particle count",
     "reseed_freq": "keep the best top_keep_fraction, redraw the others around them, this often",
@@ -167,8 +169,8 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
       the 3D attitude, the xy/yaw covariance of the filter and z variance of the particles;
       ``map → odom`` carries z and yaw (the footprint frame stays level, REP 120).
 
-    Parameters: the costmap AMCL's 13 (CATALOGUE §2.5), the original's six
-    (``inflation_stddev`` not > 0 or NaN → 1.5 with a warning, as the original; the others
+    Parameters: the costmap AMCL's 13 (same names and defaults in the original), the original's
+    six (``inflation_stddev`` not > 0 or NaN → 1.5 with a warning, as the original; the others
     fail configure when out of range, where the original replaced them silently) and
     ``initial_pose.z`` (NaN: any level; beyond the original).
 

@@ -1,4 +1,5 @@
-"""Scoring 3D scans against a Bonxai voxel map for the NavMap AMCL (CATALOGUE §6.4).
+"""Scoring 3D scans against a Bonxai voxel map for the NavMap AMCL (as the original EasyNav's
+easynav_navmap_localizer does: particles predicted on the NavMap, corrected on ``map.bonxai``).
 
 - :class:`InflatedVoxelMap`: the inflated likelihood map the original builds on first use and
   keeps under ``map.bonxai.inflated``: every voxel within reach of an occupied voxel of the

@@ -1,11 +1,11 @@
 """8-connected A* over Costmap2D costs: a readable reference and a numba-compiled twin.
 
-Cost model (the original CostmapPlanner's, CATALOGUE.md §2.6): entering a cell of cost ``c``
-costs ``(1 + cost_factor * c) * step`` with ``step`` 1 for a side move and ``diagonal_cost``
-(√2) for a diagonal one; cells with ``c >= 253`` (inscribed, lethal, unknown) are never entered.
-The start cell itself may be blocked (a robot pressed against a wall still gets a way out); its
-own cost is not paid. Diagonal moves need no free side cells (as in the original and pyastar2d):
-with an inflated map a diagonal gap between two blocked cells is itself inflated.
+Cost model (the original EasyNav's easynav_costmap_planner/CostmapPlanner's): entering a cell of
+cost ``c`` costs ``(1 + cost_factor * c) * step`` with ``step`` 1 for a side move and
+``diagonal_cost`` (√2) for a diagonal one; cells with ``c >= 253`` (inscribed, lethal, unknown) are
+never entered. The start cell itself may be blocked (a robot pressed against a wall still gets a way
+out); its own cost is not paid. Diagonal moves need no free side cells (as in the original and
+pyastar2d): with an inflated map a diagonal gap between two blocked cells is itself inflated.
 
 Heuristic: the octile distance (``max(dx, dy) + (diagonal_cost - 1) * min(dx, dy)``, exact on an
 empty grid and never more than the true cost since every step costs at least its length) times

@@ -1,12 +1,12 @@
 """A* over the NavCels of a NavMap: a readable reference and a numba-compiled twin.
 
 Graph: one node per NavCel, an edge to each NavCel sharing an edge with it
-(:attr:`NavMap.neighbors`). Cost model (the original ``easynav_navmap_planner/AStarPlanner``,
-CATALOGUE.md §6.3): entering NavCel ``v`` from ``u`` costs ``d(u, v) · m[v]``, with ``d`` the 3-D
-distance between the centroids and ``m`` the per-NavCel step multiplier of
-:func:`step_multipliers` (``max(1, cost_factor) + inflation_penalty · cost / 253``; ``inf`` for
-a NavCel that is never entered: lethal 254, unknown 255, or steeper than the slope limit). The
-start NavCel's own multiplier is not paid (nor checked here: the planner checks it).
+(:attr:`NavMap.neighbors`). Cost model (the original EasyNav's
+``easynav_navmap_planner/AStarPlanner``): entering NavCel ``v`` from ``u`` costs ``d(u, v) · m[v]``,
+with ``d`` the 3-D distance between the centroids and ``m`` the per-NavCel step multiplier of
+:func:`step_multipliers` (``max(1, cost_factor) + inflation_penalty · cost / 253``; ``inf`` for a
+NavCel that is never entered: lethal 254, unknown 255, or steeper than the slope limit). The start
+NavCel's own multiplier is not paid (nor checked here: the planner checks it).
 
 Heuristic: the centroid distance to the goal times the smallest multiplier
 ``max(1, cost_factor)``. Every step costs at least that multiple of its length, so the heuristic

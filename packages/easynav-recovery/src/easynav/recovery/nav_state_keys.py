@@ -1,4 +1,5 @@
-"""NavState keys the recovery systems read and write (REFERENCE.md §3).
+"""NavState keys the recovery systems read and write, under the original EasyNav's names (the
+AMCL covariance trace, the sensors diagnostic, the control owner).
 
 The keys shared by every component come from ``easynav.core.nav_state_keys``.
 """

@@ -20,7 +20,7 @@ def is_rate_diagnostic(key: str) -> bool:
 
 
 class MitigationArbiter:
-    """The arbitration of the DiagnosticRecoveryManager (REFERENCE.md §8).
+    """The arbitration of the DiagnosticRecoveryManager (the original EasyNav's rules, below).
 
     - At most one mitigation runs, until it returns SUCCEEDED or FAILED (no preemption).
     - When none runs, every diagnostic that is not OK (WARN included), in NavState's group order,

@@ -155,7 +155,7 @@ class SimpleRecoveryManager(RecoveryManagerBase):
             return geometry_value
         full = f"{self.plugin_name}.{name}"
         if geometry.is_set(field):
-            # seed-design: robot_geometry takes precedence when both are set.
+            # As in the original EasyNav, robot_geometry takes precedence when both are set.
             self.logger.warning(
                 f"{full} is deprecated and ignored: system_node.robot_geometry.{field} = "
                 f"{geometry_value:g} takes precedence"
