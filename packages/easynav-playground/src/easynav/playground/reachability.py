@@ -1,8 +1,9 @@
 """Which places SimplePlanner can reach: its planning grid and an 8-connected flood fill.
 
 Used to check waypoint lists before a run and by the tests of the shipped worlds. It mirrors
-SimplePlanner's rules (REFERENCE.md §9) without depending on the planner package: the map is
-downsampled by an integer factor (a coarse cell is occupied when any fine cell in it is), and
+SimplePlanner's rules (the original EasyNav's: 8-connected A* on the map downsampled to 0.2 m, cells
+free within robot_radius 0.3 + clearance_distance 0.2) without depending on the planner package: the
+map is downsampled by an integer factor (a coarse cell is occupied when any fine cell in it is), and
 a coarse cell is usable when no occupied coarse cell lies within ``robot_radius + clearance``
 (centre to centre, in cells).
 """

@@ -19,12 +19,12 @@ class OctomapMapsManager(VoxelMapsManager):
     point perceptions, with the 2D projection of :class:`VoxelMapsManager`.
 
     The original EasyNav's OctomapMapsManager is a stub (no parameters, ``update`` does nothing, no
-    NavState key: it only turns an incoming point cloud into an OcTree); this one
-    works under its name with the original's tree settings (resolution 0.3 m, hit 0.7, miss 0.4,
-    clamping 0.12–0.97). Parameters: ``octomap_path_file`` (an OctoMap binary ``.bt``, or a
-    point cloud: PCD or PLY), ``resolution`` and those of :class:`VoxelMapsManager`
-    (``package``, ``occmap_path_file`` extruded to ``wall_height`` at ``resolution``: unlike
-    Bonxai's, the grid's resolution does not replace it, see ``OCCMAP_SETS_RESOLUTION``).
+    NavState key: it only turns an incoming point cloud into an OcTree); this one works under its
+    name with the original's tree settings (resolution 0.3 m, hit 0.7, miss 0.4, clamping
+    0.12–0.97). Parameters: ``octomap_path_file`` (an OctoMap binary ``.bt``, or a point cloud: PCD
+    or PLY), ``resolution`` and those of :class:`VoxelMapsManager` (``package``,
+    ``occmap_path_file`` extruded to ``wall_height`` at ``resolution``: unlike Bonxai's, the grid's
+    resolution does not replace it, see ``OCCMAP_SETS_RESOLUTION``).
 
     NavState: ``map.octomap`` (the :class:`OctomapMap`, written when absent, updated in place)
     besides the costmap keys. ROS: ``<alias>/map`` (PointCloud2 of the occupied voxel centres,

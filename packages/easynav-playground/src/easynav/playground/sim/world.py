@@ -14,7 +14,7 @@ class World:
 
     ``occupied[y, x]`` is cell ``(x, y)``; cell ``(0, 0)`` has its lower-left corner at
     ``(origin_x, origin_y)`` and cell centres are at ``origin + (i + 0.5) * resolution``
-    (the ``.map`` convention of REFERENCE.md §9). Space outside the grid is free: rays leave
+    (the original EasyNav's ``.map`` convention). Space outside the grid is free: rays leave
     the world without a return.
 
     Thread contract: immutable after construction; any thread may read it.
@@ -136,7 +136,7 @@ class World:
 
     @classmethod
     def from_map_file(cls, path: str | Path) -> World:
-        """Load the EasyNav ``.map`` text format (REFERENCE.md §9).
+        """Load the ``.map`` text format of the original EasyNav's simple stack.
 
         First line ``width height resolution origin_x origin_y``, then ``width*height`` values
         0/1, row-major with y as the row.
