@@ -5,13 +5,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from easynav.core.types import DiagnosticLevel, DiagnosticStatus, TwistStamped
+from easynav.core.types import DiagnosticStatus, TwistStamped
+from easynav.core.velocity.velocity_rules import (
+    GUARD_DIAGNOSTIC_NAME,
+    GUARD_HARDWARE_ID,
+    GuardReport,
+    guard_diagnostic,
+    new_controller_command,
+    timeout_rule,
+)
 from easynav.core.velocity.velocity_source import VelocitySource
-
-
-def _same(a: float, b: float) -> bool:
-    # NaN-aware equality: a controller repeating the same NaN command is not a new command.
-    return a == b or (a != a and b != b)
 
 
 class CommandGuard:
@@ -32,13 +35,17 @@ class CommandGuard:
       discarded non-finite proposal lasts, OK once a valid command is proposed again. Nothing is
       written before the first problem, and afterwards only on changes.
 
+    The rules are :func:`velocity_rules.new_controller_command`,
+    :func:`velocity_rules.timeout_rule` and :func:`velocity_rules.guard_diagnostic`, the ones
+    :func:`decide_velocity` applies (this class is their stateful view).
+
     Thread contract: owned by the RT thread (controller_node's publication step); not locked.
     ``reset`` is called from the lifecycle thread while the RT loop does not run.
     Exceptions: the constructor raises ``ValueError`` for a negative or non-finite timeout.
     """
 
-    NAME = "cmd_vel"
-    HARDWARE_ID = "controller_node"
+    NAME = GUARD_DIAGNOSTIC_NAME
+    HARDWARE_ID = GUARD_HARDWARE_ID
 
     def __init__(self, cmd_timeout: float) -> None:
         if not (math.isfinite(cmd_timeout) and cmd_timeout >= 0.0):
@@ -49,7 +56,7 @@ class CommandGuard:
         self._last_proposal_time: float | None = None
         self._timeout_active = False
         self._discarded: tuple[VelocitySource, ...] = ()
-        self._reported_key: tuple[bool, tuple[VelocitySource, ...]] | None = None
+        self._reported_key: GuardReport | None = None
 
     @property
     def timeout_active(self) -> bool:
@@ -67,22 +74,11 @@ class CommandGuard:
         None (nothing in NavState ``cmd_vel``) is never new. Raises ``TypeError`` for anything
         but a TwistStamped.
         """
-        if command is None:
+        if not new_controller_command(command, self._last_stamp, self._last_values):
             return False
-        if not isinstance(command, TwistStamped):
-            raise TypeError(
-                f"NavState cmd_vel must be a TwistStamped (stamp each new command), "
-                f"got {type(command).__name__}"
-            )
         t = command.twist
-        values = (t.vx, t.vy, t.vz, t.wx, t.wy, t.wz)
-        stamp = command.header.stamp
-        if self._last_stamp is not None and _same(stamp, self._last_stamp):
-            last = self._last_values
-            if all(_same(a, b) for a, b in zip(values, last, strict=True)):
-                return False
-        self._last_stamp = stamp
-        self._last_values = values
+        self._last_stamp = command.header.stamp
+        self._last_values = (t.vx, t.vy, t.vz, t.wx, t.wy, t.wz)
         return True
 
     def update(
@@ -99,25 +95,21 @@ class CommandGuard:
         ``target_is_zero``: whether the kept target is zero. When ``timed_out`` is True the
         caller must replace the target with zero (``VelocityMux.hold_zero(TIMEOUT)``).
         """
-        if self._last_proposal_time is None or now < self._last_proposal_time:
-            # First cycle since activation, or the clock jumped back: count from now.
-            self._last_proposal_time = now
-        timed_out = False
+        timed_out, self._last_proposal_time = timeout_rule(
+            now, proposed, target_is_zero, self.cmd_timeout, self._last_proposal_time
+        )
         if proposed:
-            self._last_proposal_time = now
             self._timeout_active = False
-        elif (
-            self.cmd_timeout > 0.0
-            and not target_is_zero
-            and now - self._last_proposal_time >= self.cmd_timeout
-        ):
-            timed_out = True
+        elif timed_out:
             self._timeout_active = True
         if discarded:
             self._discarded = tuple(discarded)
         elif proposed:
             self._discarded = ()
-        return timed_out, self._diagnostic_change()
+        change, self._reported_key = guard_diagnostic(
+            self._timeout_active, self._discarded, self._reported_key, self.cmd_timeout
+        )
+        return timed_out, change
 
     def reset(self) -> None:
         """Start over (on activation): the timeout counts from the next cycle.
@@ -128,38 +120,3 @@ class CommandGuard:
         self._last_stamp = None
         self._last_values = ()
         self._last_proposal_time = None
-
-    def _diagnostic_change(self) -> DiagnosticStatus | None:
-        key = (self._timeout_active, self._discarded)
-        if key == self._reported_key:
-            return None
-        problem = self._timeout_active or bool(self._discarded)
-        if self._reported_key is None and not problem:
-            return None  # nothing is written before the first problem
-        self._reported_key = key
-        if not problem:
-            return DiagnosticStatus(
-                level=DiagnosticLevel.OK,
-                name=self.NAME,
-                message="velocity commands flowing again",
-                hardware_id=self.HARDWARE_ID,
-                values={"cmd_timeout": repr(self.cmd_timeout)},
-            )
-        messages = []
-        values = {"cmd_timeout": repr(self.cmd_timeout)}
-        if self._timeout_active:
-            messages.append(
-                f"no new velocity command for cmd_timeout = {self.cmd_timeout:g} s: braking to zero"
-            )
-            values["timeout"] = "true"
-        if self._discarded:
-            names = ", ".join(s.value for s in self._discarded)
-            messages.append(f"non-finite (NaN or inf) command discarded from: {names}")
-            values["discarded"] = names
-        return DiagnosticStatus(
-            level=DiagnosticLevel.ERROR,
-            name=self.NAME,
-            message="; ".join(messages),
-            hardware_id=self.HARDWARE_ID,
-            values=values,
-        )

@@ -16,10 +16,12 @@ class VelocityCommand:
     the last publication, or the keepalive is due). ``diagnostics``: diagnostic changes to write
     in NavState (``diagnostics.<status.name>``, i.e. ``diagnostics.cmd_vel``), usually empty.
     ``source``: the :class:`VelocitySource` value of the target in force (when no source
-    proposed this cycle, the one that set the kept target).
+    proposed this cycle, the one that set the kept target). ``reason``: why this command, in
+    words (:attr:`VelocityDecision.reason`).
     """
 
     twist: Twist
     publish: bool
     diagnostics: list[DiagnosticStatus] = field(default_factory=list)
     source: str = "none"
+    reason: str = ""

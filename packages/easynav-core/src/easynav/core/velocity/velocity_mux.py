@@ -4,9 +4,12 @@ from __future__ import annotations
 
 from easynav.core.types import Twist
 from easynav.core.velocity.mux_selection import MuxSelection
+from easynav.core.velocity.velocity_rules import (
+    check_proposal_types,
+    discard_non_finite,
+    select_source,
+)
 from easynav.core.velocity.velocity_source import VelocitySource
-
-_NO_DISCARD: tuple[VelocitySource, ...] = ()
 
 
 def _copy(twist: Twist) -> Twist:
@@ -31,6 +34,10 @@ class VelocityMux:
     it; the command guard's ``cmd_timeout`` replaces a kept non-zero target with zero, see
     :meth:`hold_zero`). A proposal with a NaN or infinite axis is discarded and reported in
     :attr:`MuxSelection.discarded`; the next valid source is used instead.
+
+    The rules are :func:`velocity_rules.discard_non_finite` and
+    :func:`velocity_rules.select_source`, the ones :func:`decide_velocity` applies (this class
+    is their stateful view for a caller that wants the mux alone).
 
     Thread contract: owned by the RT thread (controller_node's publication step); not locked.
     ``reset`` is called from the lifecycle thread while the RT loop does not run.
@@ -66,39 +73,21 @@ class VelocityMux:
         Never raises on bad velocities: non-finite proposals are discarded and reported.
         Raises ``TypeError`` naming the source when a proposal is not a Twist.
         """
-        for name, proposal in (
-            ("controller", controller),
-            ("takeover", takeover),
-            ("override", override),
-        ):
-            if proposal is not None and not isinstance(proposal, Twist):
-                raise TypeError(f"{name} proposal must be a Twist, got {type(proposal).__name__}")
-        discarded = _NO_DISCARD
-        if override is not None and not override.is_finite():
-            discarded += (VelocitySource.OVERRIDE,)
-            override = None
-        if takeover is not None and not takeover.is_finite():
-            discarded += (VelocitySource.TAKEOVER,)
-            takeover = None
-        if controller is not None and not controller.is_finite():
-            discarded += (VelocitySource.CONTROLLER,)
-            controller = None
+        check_proposal_types(controller, takeover, override)
+        controller, takeover, override, discarded = discard_non_finite(
+            controller, takeover, override
+        )
         proposed = override is not None or takeover is not None or controller is not None
-
-        if protective_stop:
-            self._set_zero(VelocitySource.PROTECTIVE_STOP)
-        elif motion_inhibited:
-            self._set_zero(VelocitySource.MOTION_INHIBITED)
-        elif override is not None:
-            self._set(override, VelocitySource.OVERRIDE)
-        elif takeover is not None:
-            self._set(takeover, VelocitySource.TAKEOVER)
-        elif paused:
-            self._set_zero(VelocitySource.PAUSE)
-        elif controller is not None:
-            self._set(controller, VelocitySource.CONTROLLER)
-        else:
+        choice = select_source(
+            controller, takeover, override, paused, protective_stop, motion_inhibited
+        )
+        if choice is None:
             return MuxSelection(self._target, self._source, False, False, discarded)
+        source, proposal = choice
+        if proposal is None:
+            self._set_zero(source)
+        else:
+            self._set(proposal, source)
         return MuxSelection(self._target, self._source, True, proposed, discarded)
 
     def hold_zero(self, source: VelocitySource) -> None:

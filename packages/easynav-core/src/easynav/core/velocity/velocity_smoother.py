@@ -6,36 +6,7 @@ import math
 
 from easynav.core.robot import RobotLimits
 from easynav.core.types import Twist
-
-
-def _check_limits(limits: RobotLimits) -> None:
-    errors = limits.validation_errors()
-    if errors:
-        raise ValueError("invalid robot limits: " + "; ".join(errors))
-
-
-def _step_axis(
-    current: float, target: float, dt: float, low: float, high: float, acc: float, dec: float
-) -> float:
-    """One axis one cycle: clamp, stop at zero before reversing, accelerate or decelerate."""
-    if target < low:
-        target = low
-    elif target > high:
-        target = high
-    if (current > 0.0 and target < 0.0) or (current < 0.0 and target > 0.0):
-        # Stop at an exact zero before changing direction: this cycle ends at zero at most,
-        # the next one starts the other way from there.
-        target = 0.0
-    diff = target - current
-    if diff == 0.0:
-        return current
-    # Speeding up: the target is farther from zero than the current value (same sign here).
-    max_step = (acc if abs(target) > abs(current) else dec) * dt
-    if abs(diff) <= max_step:
-        result = target
-    else:
-        result = current + (max_step if diff > 0.0 else -max_step)
-    return result if result != 0.0 else 0.0  # never -0.0
+from easynav.core.velocity.velocity_rules import ZERO, axis_bounds, check_limits, clamp, ramp
 
 
 class VelocitySmoother:
@@ -58,6 +29,9 @@ class VelocitySmoother:
     lowered (a safely limited speed) below the current velocity, the velocity comes down to the
     new limit braking at the deceleration limit, not at once.
 
+    The rules are :func:`velocity_rules.ramp` and :func:`velocity_rules.clamp`, the ones
+    :func:`decide_velocity` applies (this class is their stateful view).
+
     :meth:`jump_to` (OVERRIDE) and :meth:`stop_now` (protective stop) skip the ramp; the
     smoother then continues from the value they set.
 
@@ -68,7 +42,7 @@ class VelocitySmoother:
     """
 
     def __init__(self, limits: RobotLimits) -> None:
-        self._current = [0.0] * 6
+        self._current = ZERO
         self.set_limits(limits)
 
     @property
@@ -83,14 +57,10 @@ class VelocitySmoother:
 
     def set_limits(self, limits: RobotLimits) -> None:
         """Set the limits in force. Raises ``ValueError`` naming any invalid field."""
-        _check_limits(limits)
+        check_limits(limits)
         self._limits = limits
-        lin = limits.max_linear_vel
-        ang = limits.max_angular_vel
-        self._low = (limits.min_linear_vel, -lin, -lin, -ang, -ang, -ang)
-        self._high = (lin, lin, lin, ang, ang, ang)
-        self._acc = (limits.max_linear_acc,) * 3 + (limits.max_angular_acc,) * 3
-        self._dec = (limits.max_linear_decel,) * 3 + (limits.max_angular_decel,) * 3
+        self._bounds = axis_bounds(limits)
+        self._dec = self._bounds[3]
 
     def step(self, target: Twist, dt: float) -> Twist:
         """Move towards ``target`` for ``dt`` seconds; return the new output.
@@ -100,25 +70,17 @@ class VelocitySmoother:
         """
         if not (dt >= 0.0 and math.isfinite(dt)):
             raise ValueError(f"dt = {dt} must be finite and >= 0")
-        cur = self._current
-        low, high, acc, dec = self._low, self._high, self._acc, self._dec
-        tgt = (target.vx, target.vy, target.vz, target.wx, target.wy, target.wz)
-        for i in range(6):
-            cur[i] = _step_axis(cur[i], tgt[i], dt, low[i], high[i], acc[i], dec[i])
-        return Twist(*cur)
+        self._current = ramp(self._current, target.as_tuple(), dt, self._bounds)
+        return Twist(*self._current)
 
     def jump_to(self, target: Twist) -> Twist:
         """Output ``target`` at once (OVERRIDE), clamped to the velocity limits in force."""
-        cur = self._current
-        tgt = (target.vx, target.vy, target.vz, target.wx, target.wy, target.wz)
-        for i in range(6):
-            value = min(max(tgt[i], self._low[i]), self._high[i])
-            cur[i] = value if value != 0.0 else 0.0
-        return Twist(*cur)
+        self._current = clamp(target.as_tuple(), self._bounds)
+        return Twist(*self._current)
 
     def stop_now(self) -> Twist:
         """Output an exact zero at once (protective stop: the safety channel is stopping)."""
-        self._current = [0.0] * 6
+        self._current = ZERO
         return Twist()
 
     def braking_time(self) -> float:
@@ -127,4 +89,4 @@ class VelocitySmoother:
 
     def reset(self) -> None:
         """Forget the output: the next step starts from rest."""
-        self._current = [0.0] * 6
+        self._current = ZERO
