@@ -40,7 +40,7 @@ from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.system.component_node import ComponentNode, ConfigurationError
 from easynav.core.system.node_declarations import CONTROLLER_NODE_PARAMETERS
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
-from easynav.core.velocity import VelocityOutput
+from easynav.core.velocity import VelocityOutput, limits_in_force
 
 #: Topic of the colision_checker's debug markers (relative: controller_node's namespace, as the
 #: original's ControllerMethodBase publisher).
@@ -259,13 +259,16 @@ class ControllerNode(ComponentNode):
 
     # -- robot limits -----------------------------------------------------------------------------
     def limits_in_force(self) -> RobotLimits:
-        """robot_limits, cut down by a safely limited speed when the safety channel says so."""
-        limits = self.robot_limits
-        if self.nav_state.has(SAFETY_STATUS):
-            state = self.nav_state.get(SAFETY_STATUS, SafetyChannelState)
-            if state.valid and state.speed_limited:
-                limits = limits.cut_down(state.max_linear_vel, state.max_angular_vel)
-        return limits
+        """What controllers see (``get_robot_limits()``): robot_limits, cut down by a safely
+        limited speed when the safety channel says so (the velocity decision's own rule,
+        :func:`easynav.core.velocity.limits_in_force`, without the speed zone: the zone is the
+        velocity output's). Any thread (reads NavState)."""
+        safety = (
+            self.nav_state.get(SAFETY_STATUS, SafetyChannelState)
+            if self.nav_state.has(SAFETY_STATUS)
+            else None
+        )
+        return limits_in_force(self.robot_limits, safety)
 
     # -- RT cycle ---------------------------------------------------------------------------------
     def cycle_rt(self, trigger: bool) -> None:
@@ -328,7 +331,15 @@ class ControllerNode(ComponentNode):
         self.nav_state.set(CMD_VEL, TwistStamped(Header(stamp, command.header.frame_id), Twist()))
 
     def publish_cycle(self) -> None:
-        """Mux → smoother → guard → publish. RT thread, after the recovery system's RT cycle."""
+        """One velocity decision, then publish. RT thread, after the recovery system's RT cycle.
+
+        Reads what the controller, the recovery system and the safety supervisor handed over in
+        NavState and calls :meth:`VelocityOutput.cycle` (one
+        :func:`easynav.core.velocity.decide_velocity`) once with it and the robot limits; the
+        safety cut and the speed zone are applied there, once. Writes ``diagnostics.cmd_vel``
+        changes, erases the one-cycle recovery proposals and publishes when the decision says
+        so. Raises what the decision raises (a proposal of the wrong type: ``TypeError``).
+        """
         output = self.velocity_output
         if output is None or not self.active:
             return
@@ -342,12 +353,14 @@ class ControllerNode(ComponentNode):
         inhibited = bool(nav_state.get_or(MOTION_INHIBITED, False))
         # A speed zone (NavState speed_limit, a fraction) cuts the limits the output enforces,
         # not those controllers see: the zone is the velocity output's, as the safety cut is.
-        zone = nav_state.get_or(SPEED_LIMIT, 1.0)
-        limits = self.limits_in_force()
-        if isinstance(zone, float):
-            limits = limits.scaled(zone)
-        output.set_limits(limits)
-        command = output.cycle(now, controller_cmd, takeover, override, paused, safety, inhibited)
+        zone = nav_state.get_or(SPEED_LIMIT, None)
+        if not isinstance(zone, float):
+            zone = None
+        if output.robot_limits is not self.robot_limits:  # a runtime change of robot_limits.*
+            output.set_limits(self.robot_limits)
+        command = output.cycle(
+            now, controller_cmd, takeover, override, paused, safety, inhibited, zone
+        )
         # Proposals last one cycle.
         if takeover is not None:
             nav_state.erase(PROPOSAL_TAKEOVER)
