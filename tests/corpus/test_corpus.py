@@ -1,10 +1,10 @@
 """The params-file corpus (issue #22): files in the original's style pass ``easynav check``.
 
-Each ``*.params.yaml`` beside this file is written as users of the C++ original write theirs
-(node sections, ``<kind>_types``, ``<alias>.plugin`` with the original's plugin strings, the
-original's parameter names) and loads maps this project ships. Together they set every
-parameter of ``../shared/spec/CATALOGUE.md`` and name every plugin registered in the entry-point
-groups below (README.md beside this file lists what each file covers).
+Each ``*.params.yaml`` beside this file is written as users of the C++ original write theirs (node
+sections, ``<kind>_types``, ``<alias>.plugin`` with the original's plugin strings, the original's
+parameter names) and loads maps this project ships. Together they set every parameter the original's
+plugins declare (easynav_plugins 0.4.2 and the related stacks) and name every plugin registered in
+the entry-point groups below (README.md beside this file lists what each file covers).
 
 The tests: each file configures (``easynav check`` exits 0); the keys ``easynav check`` reports as
 unknown are exactly the known incompatibilities listed in ``KNOWN_UNKNOWN_KEYS`` (a new one is a
@@ -33,8 +33,8 @@ CORPUS = Path(__file__).resolve().parent
 EASYNAV = str(Path(sys.executable).with_name("easynav"))
 FILES = sorted(CORPUS.glob("*.params.yaml"))
 
-#: Entry-point groups whose plugin strings the corpus must name: the hosts and filters of
-#: CATALOGUE.md, the recovery system's parts and the perception handlers.
+#: Entry-point groups whose plugin strings the corpus must name: the hosts and filters of the
+#: original's catalogue, the recovery system's parts and the perception handlers.
 PLUGIN_GROUPS = (
     "easynav.controllers",
     "easynav.localizers",

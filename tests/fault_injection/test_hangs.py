@@ -52,7 +52,8 @@ def test_hanging_rt_plugin_makes_rt_cycles_late(ros, start_easynav, plugin):
     assert ros.spin_until(lambda: level_is(rt, "rt_cycle", DiagnosticLevel.WARN), timeout=2.0)
     assert diagnostic(rt, "rt_cycle").hardware_id == "system_node"
     # Late cycle after late cycle: RT_ERROR after max_late_cycles (10) in a row, but outside
-    # safety mode a late RT cycle is only a WARN (seed-design), and only reported.
+    # safety mode a late RT cycle is only a WARN (navigation is unaffected while the components
+    # keep their frequencies), and only reported.
     monitor = rt.system_node.safety.rt_monitor
     assert ros.spin_until(lambda: monitor.status == RT_ERROR, timeout=3.0)
     assert ros.spin_until(lambda: "in a row" in diagnostic(rt, "rt_cycle").message, 1.0)

@@ -2,12 +2,13 @@
 
 EasyNav runs in this process (``EasyNavRuntime``, what ``easynav run`` does) so that the test can
 use the recovery system's action ``request_reconfigure``, the only way a reconfiguration is
-requested (REFERENCE.md §8); the playground is a separate process as usual. While the robot
-drives to the first of two waypoints, the plugin under the controller alias ``simple`` is
-switched from SimpleController to DummyController (EasyNav goes active → inactive → unconfigured
-→ inactive → active; the robot stops; the mission survives), then back to SimpleController with
-other gains (``look_ahead_dist`` 0.3 → 0.5, ``k_rot`` 0.5 → 0.8). The robot drives on and visits
-both waypoints; the localizer keeps its pose across both reconfigurations.
+requested (between non-RT cycles: deactivate, cleanup, set, configure, activate); the playground is
+a separate process as usual. While the robot drives to the first of two waypoints, the plugin under
+the controller alias ``simple`` is switched from SimpleController to DummyController (EasyNav goes
+active → inactive → unconfigured → inactive → active; the robot stops; the mission survives), then
+back to SimpleController with other gains (``look_ahead_dist`` 0.3 → 0.5, ``k_rot`` 0.5 → 0.8). The
+robot drives on and visits both waypoints; the localizer keeps its pose across both
+reconfigurations.
 """
 
 from __future__ import annotations

@@ -1,13 +1,14 @@
 """Scenario: the localizer is switched from AMCL to the UKF fusion localizer mid-mission.
 
-The seed: "Localizers continue from the last known pose. On its first cycle, a localizer gets the
-valid robot_pose left in NavState by the previous one, of any type (e.g. AMCL ↔ Fusion), through
-LocalizerMethodBase::on_last_known_pose()". The robot drives with AMCL (laser on the home map);
-while it drives to the first of two waypoints, the recovery system's ``request_reconfigure``
-switches the plugin under the localizer alias ``simple`` to ``FusionLocalizer`` (wheel odometry
-and the IMU only: no GNSS indoors, so nothing but the handed-over pose can place it on the map).
-The mission survives the reconfiguration and completes; the estimate stays on the robot: had the
-fusion localizer started from its own origin instead of AMCL's last pose, it would be metres off.
+As in the original EasyNav: "Localizers continue from the last known pose. On its first cycle, a
+localizer gets the valid robot_pose left in NavState by the previous one, of any type (e.g. AMCL ↔
+Fusion), through LocalizerMethodBase::on_last_known_pose()". The robot drives with AMCL (laser on
+the home map); while it drives to the first of two waypoints, the recovery system's
+``request_reconfigure`` switches the plugin under the localizer alias ``simple`` to
+``FusionLocalizer`` (wheel odometry and the IMU only: no GNSS indoors, so nothing but the
+handed-over pose can place it on the map). The mission survives the reconfiguration and completes;
+the estimate stays on the robot: had the fusion localizer started from its own origin instead of
+AMCL's last pose, it would be metres off.
 """
 
 from __future__ import annotations
