@@ -26,6 +26,7 @@ from easynav.core.system.recovery_node import RecoveryNode
 from easynav.core.system.runtime_reconfiguration import RuntimeReconfiguration
 from easynav.core.system.safety_supervisor import SafetySupervisor
 from easynav.core.system.sensors_node import SensorsNode
+from easynav.core.system.shared_clock import SharedClockSubscription
 from easynav.core.system.system_context import SystemContext
 from easynav.core.system.system_requests import SystemRequests
 from easynav.core.tf import TFInfo, TFListener, get_tf_buffer
@@ -100,6 +101,11 @@ class SystemNode(LifecycleNode):
         # (the safety channel's status, TF). rclpy serves a node from one executor only.
         self.rt_io_node = Node("_system_node_rt", namespace=namespace, **kwargs)
         self.system.rt_node = self.rt_io_node  # plugins' RT-side subscriptions (odometry)
+        # One /clock subscription for the eight nodes instead of eight: sensors_node's (the RT
+        # loop serves it; the ROS graph check sees an EasyNav node waiting for /clock).
+        self.shared_clock = SharedClockSubscription(
+            self.sensors_node, [*self.all_nodes(), self.rt_io_node]
+        )
         # The buffer is shared by everything in this process under this namespace: transforms
         # left by an earlier system (a runtime stopped and started again, the next test) are
         # on another run's time line and would shadow this run's for the cache window.
