@@ -20,7 +20,8 @@ from easynav.core.velocity.velocity_source import VelocitySource
 class CommandGuard:
     """Decides which controller commands are new, applies ``cmd_timeout`` and reports it.
 
-    seed-safety.txt, "Stale and invalid commands":
+    The rules against stale and invalid commands (a driver must never keep executing a command
+    nobody renews, nor receive NaN):
 
     * **Only new controller commands** are proposed: :meth:`is_new_controller_command` is True
       when the stamp or any value differs from the previous command it saw (NaN-aware, so the

@@ -19,7 +19,8 @@ def _copy(twist: Twist) -> Twist:
 class VelocityMux:
     """Picks the target velocity among the proposals of one RT cycle.
 
-    Priority, highest first (REFERENCE.md §6, seed-safety.txt "Safety channel status"):
+    Priority, highest first (the original EasyNav's mux order, with the safety channel's stop
+    above everything, as a certified channel beside EasyNav requires):
 
     1. PROTECTIVE_STOP — the safety channel stops the robot (or its state is not valid): zero;
     2. MOTION_INHIBITED — the safety supervisor inhibits motion (old pose in safety mode): zero;

@@ -17,7 +17,7 @@ from easynav.core.velocity.velocity_state import VelocityState
 
 
 class VelocityOutput:
-    """controller_node's single velocity output (seed-design.txt "Velocity Output").
+    """controller_node's single velocity output: the one place a command leaves EasyNav.
 
     Holds the settings (robot limits, ``cmd_timeout``, ``keepalive_period``, ``max_dt``) and
     the :class:`VelocityState` between cycles; every RT cycle, after the controller and the

@@ -8,7 +8,7 @@ from enum import Enum
 class VelocitySource(str, Enum):
     """The sources of the velocity mux, plus the guard's and the idle states.
 
-    Priority, highest first (REFERENCE.md §6): PROTECTIVE_STOP > MOTION_INHIBITED > OVERRIDE >
+    Priority, highest first: PROTECTIVE_STOP > MOTION_INHIBITED > OVERRIDE >
     TAKEOVER > PAUSE > CONTROLLER. ``TIMEOUT`` is the zero target the command guard sets when no
     source proposed a new command for ``cmd_timeout``; ``NONE`` is the state before any proposal.
     ``BRAKE`` is the deactivation/shutdown ramp (:meth:`VelocityOutput.brake_sequence`).
