@@ -6,7 +6,7 @@ import threading
 import time
 from collections.abc import Callable
 
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException
 
 from easynav.core.safety.realtime import set_thread_realtime
 
@@ -38,7 +38,7 @@ class CycleLoop(threading.Thread):
         self,
         name: str,
         freq: float,
-        executor: SingleThreadedExecutor,
+        executor: Executor,
         cycle: Callable[[bool], None],
         spin_time: float,
         wake: Callable[[], bool] | None = None,

@@ -22,6 +22,32 @@ from easynav.core.system.system_node import SystemNode
 #: SCHED_FIFO priority of the non-RT loop with ``use_real_time``: below the RT loop's 80.
 NORT_PRIORITY = 70
 
+#: ``EASYNAV_EXECUTOR=single``: rclpy's SingleThreadedExecutor instead of its EventsExecutor.
+EXECUTOR_ENV = "EASYNAV_EXECUTOR"
+
+
+def make_executor(context: rclpy.Context):
+    """The executor of one loop: rclpy's EventsExecutor (``rclpy.experimental``, C++), else its
+    SingleThreadedExecutor (an rclpy without it, or ``EASYNAV_EXECUTOR=single``).
+
+    Why (issue #21): the SingleThreadedExecutor builds a new wait set in Python at every
+    ``spin_once`` (every entity of every node: 72 services and 16-41 QoS event handlers for the
+    non-RT loop's six lifecycle nodes), 0.3-1 ms each, and the loops call it at least once per
+    cycle (200 Hz each): measured with ``easynav demo`` (home, simple stack) on an idle machine,
+    ``easynav run`` 37 % of a core with it, 14 % with the EventsExecutor, which keeps its
+    entities between calls and is woken by the middleware's events. Same loops, same rates,
+    same callbacks in the same threads; the RT loop's timing (bench_rt_loop.py) meets its goal
+    with both.
+    """
+    if os.environ.get(EXECUTOR_ENV, "").strip().lower() != "single":
+        try:
+            from rclpy.experimental import EventsExecutor
+        except ImportError:
+            pass
+        else:
+            return EventsExecutor(context=context)
+    return SingleThreadedExecutor(context=context)
+
 
 @dataclass
 class RuntimeResult:
@@ -35,7 +61,8 @@ class EasyNavRuntime:
     """Hosts one EasyNav instance in this process (what ``easynav run`` does).
 
     - ``start()``: rclpy context with the params file, system_node and its sub-nodes, one
-      SingleThreadedExecutor per loop (MultiThreadedExecutor is unusable in this rclpy), the RT
+      single-threaded executor per loop (:func:`make_executor`; MultiThreadedExecutor is
+      unusable in this rclpy), the RT
       loop (sensors_node and its subscriptions; SCHED_FIFO 80 when ``use_real_time``) and the
       non-RT loop (every other node: goal topics, lifecycle services, plugin topics; SCHED_FIFO
       70 when ``use_real_time``, so it is not preempted while it holds the GIL), then
@@ -67,8 +94,8 @@ class EasyNavRuntime:
         self.system_node = SystemNode(self.nav_state, namespace, context=self.context)
         self.requests = self.system_node.requests
         self.error = ""
-        self.rt_executor = SingleThreadedExecutor(context=self.context)
-        self.nort_executor = SingleThreadedExecutor(context=self.context)
+        self.rt_executor = make_executor(self.context)
+        self.nort_executor = make_executor(self.context)
         self.rt_executor.add_node(self.system_node.sensors_node)
         self.rt_executor.add_node(self.system_node.rt_io_node)
         for node in self.system_node.all_nodes():
