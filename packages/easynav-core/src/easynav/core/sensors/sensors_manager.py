@@ -47,11 +47,11 @@ class SensorsManager:
     reliable publisher is compatible). Each message is converted by the sensor's
     :class:`~easynav.core.sensors.perception_handler.PerceptionHandler` and stored under the
     sensor id; a sensor with a ``group`` is put in that group, which hides it from
-    ``NavState.get_no_group``. Data age (seed-safety "Data age"): every RT cycle a perception
-    older than ``forget_time`` is replaced by a copy with ``valid`` False; a message arriving
-    already older than that (or stamped more than ``forget_time`` in the future) is stored
-    invalid and never used. ``new_data`` is True on a perception during the RT cycle after it
-    arrived and False afterwards.
+    ``NavState.get_no_group``. Data age (old data must not pass for current): every RT
+    cycle a perception older than ``forget_time`` is replaced by a copy with ``valid`` False;
+    a message arriving already older than that (or stamped more than ``forget_time`` in the
+    future) is stored invalid and never used. ``new_data`` is True on a perception during the
+    RT cycle after it arrived and False afterwards.
 
     Thread contract: ``configure``/``cleanup`` in the configuring thread with no loop running;
     the subscription callbacks (:meth:`handle_message`) and :meth:`cycle_rt` in the RT thread;

@@ -313,7 +313,7 @@ class ComponentNode(LifecycleNode):
             lp = LoadedPlugin(alias, name, plugin, self.system.diagnostic_name(node, alias))
             if plugin.HAS_RT_UPDATE and self.MONITOR_RT:
                 # The message names the parameter as the key does: node-qualified when several
-                # nodes share the alias (the seed calls every plugin "simple").
+                # nodes share the alias (the original's example params name every plugin "simple").
                 lp.rt_monitor = RateMonitor(
                     f"{lp.diag_name}.rt_rate", plugin.rt_freq, node, f"{lp.diag_name}.rt_freq"
                 )
@@ -323,8 +323,9 @@ class ComponentNode(LifecycleNode):
                 )
             self.plugins.append(lp)
 
-    #: Which rates are monitored for this node's plugins (REFERENCE: rt_rate for controllers and
-    #: localizer RT updates; rate for localizer, maps manager, planner and recovery evaluators).
+    #: Which rates are monitored for this node's plugins (``rt_rate`` for controllers and
+    #: localizer RT updates; ``rate`` for localizer, maps manager, planner and recovery
+    #: evaluators, as the original EasyNav reports them).
     MONITOR_RT = True
     MONITOR_NON_RT = True
 

@@ -47,7 +47,8 @@ CONTROLLER_NODE_PARAMETERS = (
 
 
 
-#: system_node's own parameters (REFERENCE.md §1); the goal manager's follow.
+#: system_node's own parameters (names and defaults of the original's system_node); the goal
+#: manager's follow.
 SYSTEM_PARAMETERS: tuple[Param, ...] = (
     Param("use_real_time", True, "RT loop at SCHED_FIFO priority when allowed", dynamic=False),
     Param("rt_freq", 200.0, "frequency of the RT cycle", "Hz", gt=0.0, dynamic=False),
@@ -76,7 +77,8 @@ SYSTEM_PARAMETERS: tuple[Param, ...] = (
 SYSTEM_PARAMETERS_BY_NAME = {param.name: param for param in SYSTEM_PARAMETERS}
 
 
-#: safety.* parameters of system_node (seed-safety.txt). Runtime changes go through the
+#: safety.* parameters of system_node: the safety mode and the checks it enables (heartbeat,
+#: RT monitor, safety channel, pose age, memory locking). Runtime changes go through the
 #: frozen-configuration guard.
 SAFETY_PARAMETERS: tuple[Param, ...] = (
     Param("safety.mode", False, "safety mode: frozen configuration, fail-stop on RT overruns"),

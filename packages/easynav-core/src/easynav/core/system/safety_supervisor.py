@@ -1,4 +1,5 @@
-"""SafetySupervisor: system_node's safety duties (seed-safety.txt), delegating to core.safety."""
+"""SafetySupervisor: system_node's safety duties (checks, heartbeat, safety channel, frozen
+configuration), delegating to core.safety."""
 
 from __future__ import annotations
 
@@ -120,7 +121,7 @@ class SafetySupervisor:
         try:
             p = read_parameters(SAFETY_PARAMETERS, node.params, "")
         except ParameterValueError as exc:
-            # Safety errors name their parameter as node/name (seed-safety.txt).
+            # Safety errors name their parameter as node/name, so an integrator finds it at once.
             raise ConfigurationError(f"system_node/{exc}") from None
         self.mode = bool(p["safety.mode"])
         parameters = self.effective_parameters()

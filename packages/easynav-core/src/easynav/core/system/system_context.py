@@ -34,6 +34,7 @@ class SystemContext:
 
     def diagnostic_name(self, node_name: str, alias: str) -> str:
         """The name under ``diagnostics.`` for a plugin: its alias, or ``<node>.<alias>`` when
-        the same alias is used by several nodes (the seed's example names them all "simple").
+        the same alias is used by several nodes (the original's example params name them all
+        "simple").
         """
         return self.diagnostic_names.get((node_name, alias), alias)

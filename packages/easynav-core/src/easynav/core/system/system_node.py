@@ -54,8 +54,8 @@ TYPES_PARAMETERS = {
 
 class SystemNode(LifecycleNode):
     """system_node: configures, activates, deactivates and cleans up its six sub-nodes (all or
-    nothing), holds the system parameters, runs the RT and non-RT cycles in the order of
-    REFERENCE.md §1 (called by the loops while active) and hosts the goal manager.
+    nothing), holds the system parameters, runs the RT and non-RT cycles in the original's
+    order (called by the loops while active) and hosts the goal manager.
 
     Thread contract: lifecycle transitions run in the thread that triggers them (the runtime's
     main thread, or the non-RT loop for lifecycle services and reconfigurations); they wait for
@@ -301,8 +301,8 @@ class SystemNode(LifecycleNode):
 
     # -- cycles -----------------------------------------------------------------------------------
     def cycle_rt(self, triggered: bool = False) -> None:
-        """One RT cycle (REFERENCE.md §1): safety monitor → sensors → localizer → controller →
-        recovery → velocity publication. RT thread.
+        """One RT cycle, in the original's order: safety monitor → sensors → localizer →
+        controller → recovery → velocity publication. RT thread.
         """
         with self.rt_lock:
             if not self.active:
@@ -330,7 +330,7 @@ class SystemNode(LifecycleNode):
         return self.active and self.sensors_node.new_data_pending()
 
     def cycle(self) -> None:
-        """One non-RT cycle (REFERENCE.md §1): sensors → localizer → maps → goal manager →
+        """One non-RT cycle, in the original's order: sensors → localizer → maps → goal manager →
         planner → recovery → NavState debug topic. Non-RT thread.
         """
         with self.nort_lock:
