@@ -112,10 +112,15 @@ class CycleLoop(threading.Thread):
                 end_of_cycle = monotonic()
                 if end_of_cycle > deadline + period:  # more than one period behind: restart
                     deadline = end_of_cycle + period
-                spin_until = end_of_cycle + self.spin_time
-                # Overran: serve pending callbacks for at most spin_time, then cycle again.
-                while monotonic() < min(spin_until, deadline + period) and monotonic() >= deadline:
-                    if not self._spin(0.0):
+                # Overran: serve pending callbacks for at most spin_time, then cycle again. The
+                # executor waits for them (no polling: with the EventsExecutor a spin_once(0)
+                # costs microseconds, and polling burnt the whole spin_time after each overrun).
+                window_end = min(end_of_cycle + self.spin_time, deadline + period)
+                while True:
+                    now = monotonic()
+                    if now >= window_end or now < deadline:
+                        break
+                    if not self._spin(window_end - now):
                         return
                     if stop.is_set():
                         return
