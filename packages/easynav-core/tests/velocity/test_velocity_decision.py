@@ -19,7 +19,7 @@ import dataclasses
 import math
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from easynav.core.robot import RobotLimits
@@ -114,6 +114,13 @@ def protective_stop(safety: SafetyChannelState | None) -> bool:
     )
 
 
+def _clamped(twist: Twist | None, low, high) -> tuple[float, ...] | None:
+    if twist is None:
+        return None
+    return tuple(min(max(v, lo), hi) for v, lo, hi in zip(twist.as_tuple(), low, high,
+                                                          strict=True))
+
+
 def exact_zero(twist: Twist) -> bool:
     return all(v == 0.0 and math.copysign(1.0, v) > 0.0 for v in twist.as_tuple())
 
@@ -125,6 +132,18 @@ def exact_zero(twist: Twist) -> bool:
     keepalive=st.sampled_from([0.0, 0.1]),
     max_dt=st.sampled_from([0.01, 0.1, 1.0]),
     sequence=st.lists(steps, min_size=1, max_size=60),
+)
+# Found by this test in an isolated install: an OVERRIDE takes over at once, even from a
+# command beyond a speed zone that has just lowered the limits (the sign may flip at once).
+@example(
+    limits=RobotLimits(1.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0),
+    cmd_timeout=0.0,
+    keepalive=0.0,
+    max_dt=0.01,
+    sequence=[
+        Step(0.03125, "none", Twist(), None, Twist(vz=-1.0), False, None, False, None),
+        Step(0.0, "none", Twist(), None, Twist(vz=1.0), False, None, False, 0.5),
+    ],
 )
 def test_never_nan_zero_in_a_stop_within_the_limits_in_force(
     limits, cmd_timeout, keepalive, max_dt, sequence
@@ -166,6 +185,11 @@ def test_never_nan_zero_in_a_stop_within_the_limits_in_force(
             # Never beyond the robot limits.
             assert robot_low[i] - EPS <= out[i] <= robot_high[i] + EPS, (i, out, limits)
             if low[i] - EPS <= previous[i] <= high[i] + EPS:
+                assert low[i] - EPS <= out[i] <= high[i] + EPS, (i, previous, out, low, high)
+            elif decision.source is VelocitySource.OVERRIDE and out == _clamped(step.override,
+                                                                                   low, high):
+                # A fresh OVERRIDE (a recovery emergency) is applied at once, clamped to the
+                # limits in force, even when the previous command was beyond them.
                 assert low[i] - EPS <= out[i] <= high[i] + EPS, (i, previous, out, low, high)
             else:  # braking down to limits lowered below the previous command
                 assert abs(out[i]) <= abs(previous[i]) + EPS, (i, previous, out)
