@@ -81,3 +81,34 @@ def test_demo_robots_option(capsys):
     assert main(["--robots", "3", "--world", "crossing"]) == 2  # it declares two
     err = capsys.readouterr().err
     assert ">= 1" in err and "--waypoints" in err and "declares 2 robot" in err
+
+
+class _Publisher:
+    def __init__(self, namespace: str, name: str) -> None:
+        self.node_namespace, self.node_name = namespace, name
+
+
+class _Graph:
+    """What get_publishers_info_by_topic answers, topic by topic."""
+
+    def __init__(self, publishers: dict[str, list[_Publisher]]) -> None:
+        self.publishers = publishers
+
+    def get_publishers_info_by_topic(self, topic: str) -> list[_Publisher]:
+        return self.publishers.get(topic, [])
+
+
+def test_the_topic_watch_names_a_foreign_publisher_and_skips_one_of_unknown_node():
+    from easynav.playground.demo.fleet_demo import UNKNOWN_NODE, TopicWatch
+
+    watch = TopicWatch()
+    # A look while r2's EasyNav starts: the middleware knows its publishers, not their node.
+    watch.look(_Graph({
+        "/r2/cmd_vel": [_Publisher("/r2", "controller_node"), _Publisher("/", UNKNOWN_NODE)],
+        "/r1/tf": [_Publisher("/", "playground"), _Publisher("/r1", "localizer_node")],
+    }), ["r1", "r2"])
+    assert watch.apart and watch.samples == 1
+    # r1's controller publishing on r2's cmd_vel is a crossing, named.
+    watch.look(_Graph({"/r2/cmd_vel": [_Publisher("/r1", "controller_node")]}), ["r1", "r2"])
+    assert watch.crossings == ["/r2/cmd_vel published by /r1/controller_node"]
+    assert not watch.apart
