@@ -33,7 +33,7 @@ import numpy as np
 import yaml
 
 from easynav.core.benchmarking import BenchRow, add_json_option, report
-from easynav.core.testing.dds_isolation import reserve_domain
+from easynav.system.testing.dds_isolation import reserve_domain
 
 REPO = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent

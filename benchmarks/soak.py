@@ -73,7 +73,7 @@ def memory_growth(minutes: list[float], rss: list[float], total: float) -> tuple
 def with_heartbeat(params_path: Path, out_path: Path) -> dict:
     """Write ``out_path``: the params file with ``system_node``'s heartbeat on (every
     HEARTBEAT_PERIOD s); returns system_node's parameters (as written)."""
-    from easynav.core.cli.params_file import load_ros_yaml
+    from easynav.system.cli.params_file import load_ros_yaml
 
     params = load_ros_yaml(Path(params_path).read_text())
     system = params.setdefault("system_node", {}).setdefault("ros__parameters", {})
@@ -86,7 +86,7 @@ def with_heartbeat(params_path: Path, out_path: Path) -> dict:
 
 def rt_loop_settings(system: dict) -> tuple[float, float]:
     """``(rt_freq, max_period_factor)`` of system_node: from the params, else the defaults."""
-    from easynav.core.system.node_declarations import (
+    from easynav.system.node_declarations import (
         SAFETY_PARAMETERS,
         SYSTEM_PARAMETERS_BY_NAME,
     )
@@ -137,11 +137,11 @@ def run_patrol(children, domain, path_topic, waypoints, minutes, timeout, log) -
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
-    from easynav.core.goals.goal_client_state import GoalClientState as S
-    from easynav.core.goals.goal_manager_client import GoalManagerClient
     from easynav.core.types import Header, Pose, PoseStamped
     from easynav.playground.demo.run_monitor import RunMonitor
     from easynav.playground.demo.waypoint_result import WaypointResult
+    from easynav.system.goals.goal_client_state import GoalClientState as S
+    from easynav.system.goals.goal_manager_client import GoalManagerClient
 
     class SoakMonitor(RunMonitor):
         """RunMonitor that also keeps when each heartbeat arrived (wall) with its count."""
@@ -339,13 +339,13 @@ def main() -> int:
     if not (math.isfinite(args.minutes) and args.minutes > 0):
         parser.error("--minutes must be > 0")
 
-    from easynav.core.testing.dds_isolation import reserve_domain
     from easynav.playground.demo.child_process import ChildProcess
     from easynav.playground.demo.demo import _easynav_command
     from easynav.playground.demo.params_patch import derive_params
     from easynav.playground.demo.run_summary import RunSummary
     from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
     from easynav.playground.world_description import WorldDescription
+    from easynav.system.testing.dds_isolation import reserve_domain
 
     description = WorldDescription.resolve(args.world)
     waypoints = yaml.safe_load(description.waypoints_path.read_text())["waypoints"]

@@ -242,17 +242,24 @@ def closure(
     """The named packages and every sibling they need, directly or through another sibling
     (with the requirement that brought it in; None for the named ones)."""
     seen: dict[str, tuple[Package, Requirement | None]] = {n: (packages[n], None) for n in names}
-    todo = [packages[n] for n in names]
-    # The named packages' test extras may name siblings too (the kernel's tests inject faults
-    # with easynav-faulty): those are built as well.
-    extra = [r for n in names for r in packages[n].extras.get("test", [])]
-    while todo or extra:
-        reqs = extra or todo.pop().requirements
-        extra = []
-        for req in reqs:
-            if req.name in packages and req.name not in seen:
-                seen[req.name] = (packages[req.name], req)
-                todo.append(packages[req.name])
+    # The named packages' test extras may name siblings too (a plugin distribution's ROS tests
+    # need easynav-system[test], whose safety tests inject faults with easynav-faulty); so may
+    # any extra a requirement asks for: those siblings are built as well.
+    queue: list[list[Requirement]] = [packages[n].requirements for n in names]
+    queue += [packages[n].extras.get("test", []) for n in names]
+    followed: set[tuple[str, str]] = set()
+    while queue:
+        for req in queue.pop():
+            if req.name not in packages:
+                continue
+            sibling = packages[req.name]
+            if req.name not in seen:
+                seen[req.name] = (sibling, req)
+                queue.append(sibling.requirements)
+            for extra in req.extras:
+                if (req.name, extra) not in followed:
+                    followed.add((req.name, extra))
+                    queue.append(sibling.extras.get(extra, []))
     return list(seen.values())
 
 
@@ -284,14 +291,13 @@ def isolated(
         vpy = str(venv / "bin" / "python")
         run([vpy, "-m", "pip", "install", "--quiet", "--upgrade", "pip"])
         targets = []
-        installed = {pkg.name for pkg, _ in closure(packages, names)}
         for name in names:
             pkg = packages[name]
             extra = "[test]" if "test" in pkg.extras else ""
             wheel = next(wheels.glob(pkg.name.replace("-", "_") + "-*.whl"))
             targets.append(f"{wheel}{extra}")
-        if "easynav-core" in installed and "easynav-core" not in names:
-            # The kernel's test extra: its fixtures and test tools serve every package's tests.
+        if not any("test" in packages[name].extras for name in names):
+            # No test extra of their own: the kernel's brings the test tools.
             core = next(wheels.glob("easynav_core-*.whl"))
             targets.append(f"{core}[test]")
         run([vpy, "-m", "pip", "install", "--quiet", "--find-links", str(wheels), *targets])
@@ -397,7 +403,8 @@ def main(argv: list[str]) -> int:
             return 0
         if args.command == "isolated-all":
             failed = []
-            for name in sorted(packages):
+            # A distribution without tests (the meta-distribution easynav) has nothing to run.
+            for name in sorted(n for n in packages if (packages[n].folder / "tests").is_dir()):
                 for siblings in ("lowest", "highest"):
                     code = isolated(packages, [name], args.python, siblings,
                                     pytest_args or ["-q", "-m", "not slow", "-n", "2"])

@@ -70,9 +70,17 @@ if [ "$(cat "$STAMPS/packages" 2>/dev/null)" != "$step" ]; then
   for pkg in packages/*/; do
     name=$(basename "$pkg")
     [ "$name" = easynav-interfaces ] && continue
-    # "[all]": every optional extra of the package (OMPL, GTSAM, numba, ...): the test suite
-    # exercises them all. A package without extras gets a harmless "no extra 'all'" note.
-    if grep -q '^all = ' "$pkg/pyproject.toml"; then args+=(-e "$pkg[all]"); else args+=(-e "$pkg"); fi
+    # Every optional extra the test suite exercises: "all" (OMPL, GTSAM, numba, ...), "ros" (what
+    # a plugin distribution needs inside the runtime) and "test".
+    extras=()
+    for extra in all ros test; do
+      grep -q "^$extra = " "$pkg/pyproject.toml" && extras+=("$extra")
+    done
+    if [ ${#extras[@]} -gt 0 ]; then
+      args+=(-e "$pkg[$(IFS=,; echo "${extras[*]}")]")
+    else
+      args+=(-e "$pkg")
+    fi
   done
   pip_install --no-build-isolation "${args[@]}"
   echo "$step" > "$STAMPS/packages"

@@ -15,7 +15,7 @@ _HERE = str(Path(__file__).resolve().parent)
 if _HERE not in sys.path:
     sys.path.insert(0, _HERE)
 
-from easynav.core.testing.system_fixtures import write_params  # noqa: E402
+from easynav.system.testing.system_fixtures import write_params  # noqa: E402
 
 
 @pytest.fixture

@@ -71,8 +71,8 @@ def full_speed(twist: Twist | None) -> bool:
 
 def navigate_to(ros, client, x: float, y: float, yaw: float = 0.0) -> None:
     """Send a goal (or a goal update) with a GoalManagerClient and wait until it is accepted."""
-    from easynav.core.goals.goal_client_state import GoalClientState
     from easynav.core.types import Header, Pose, PoseStamped
+    from easynav.system.goals.goal_client_state import GoalClientState
 
     assert ros.spin_until(client.manager_available, timeout=10.0), "no goal manager"
     client.send_goal(PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(x, y, yaw)))

@@ -10,7 +10,7 @@ import dataclasses
 from typing import Any
 
 from easynav.core.robot import RobotLimits
-from easynav.core.testing.system_fixtures import system_params
+from easynav.system.testing.system_fixtures import system_params
 
 #: The limits every test checks against (fast ramps keep the tests short).
 LIMITS = RobotLimits(

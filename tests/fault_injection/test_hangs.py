@@ -27,8 +27,8 @@ from fault_system import (
     inject,
 )
 
-from easynav.core.safety import RT_ERROR
 from easynav.core.types import DiagnosticLevel
+from easynav.system.safety import RT_ERROR
 
 pytestmark = pytest.mark.ros
 

@@ -13,8 +13,8 @@ from cmd_vel_recorder import CmdVelRecorder
 from fault_checks import injector, level_is, navigate_to
 from fault_system import PLANNER, faulty_system, inject
 
-from easynav.core.goals.goal_manager_client import GoalManagerClient
 from easynav.core.types import DiagnosticLevel, Path
+from easynav.system.goals.goal_manager_client import GoalManagerClient
 
 pytestmark = pytest.mark.ros
 

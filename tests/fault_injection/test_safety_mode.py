@@ -21,8 +21,8 @@ from fault_checks import (
 from fault_system import CONTROLLER, LIMITS, LOCALIZER, faulty_system, inject
 from safety_channel import start_safety_channel
 
-from easynav.core.safety import try_sched_fifo
 from easynav.core.types import DiagnosticLevel, Header, Odometry, Pose
+from easynav.system.safety import try_sched_fifo
 
 pytestmark = [
     pytest.mark.ros,

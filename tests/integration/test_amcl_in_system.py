@@ -7,8 +7,8 @@ import math
 
 import pytest
 
-from easynav.core.testing.system_fixtures import system_params
 from easynav.core.types import Odometry
+from easynav.system.testing.system_fixtures import system_params
 
 pytestmark = pytest.mark.ros
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from easynav.core.goals.goal_client_state import GoalClientState
-from easynav.core.goals.goal_manager_client import GoalManagerClient
-from easynav.core.testing.system_fixtures import DUMMY_SYSTEM, system_params, wait_for
 from easynav.core.types import Header, Odometry, Path, Pose, PoseStamped
+from easynav.system.goals.goal_client_state import GoalClientState
+from easynav.system.goals.goal_manager_client import GoalManagerClient
+from easynav.system.testing.system_fixtures import DUMMY_SYSTEM, system_params, wait_for
 
 pytestmark = pytest.mark.ros
 

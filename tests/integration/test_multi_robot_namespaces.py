@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from easynav.core.testing.system_fixtures import system_params
 from easynav.core.tf import get_tf_buffer
+from easynav.system.testing.system_fixtures import system_params
 
 pytestmark = pytest.mark.ros
 #: ROS's own global topics, which every node has.

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 import yaml
 
-from easynav.core.testing.system_fixtures import system_params
 from easynav.core.tf import get_tf_buffer
+from easynav.system.testing.system_fixtures import system_params
 
 pytestmark = pytest.mark.ros
 

@@ -26,7 +26,6 @@ from pathlib import Path
 
 import yaml
 
-from easynav.core.cli.params_file import load_ros_yaml
 from easynav.core.plugins.compatibility import (
     compatible,
     needed_maps,
@@ -35,6 +34,7 @@ from easynav.core.plugins.compatibility import (
 )
 from easynav.core.plugins.discovery import list_plugins, load_plugin_class
 from easynav.core.plugins.plugin_kinds import ALL_KINDS
+from easynav.system.cli.params_file import load_ros_yaml
 
 ROOT = Path(__file__).resolve().parents[2]
 PARAMS_DIR = ROOT / "params"

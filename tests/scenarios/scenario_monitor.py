@@ -10,8 +10,8 @@ from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import Log
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from easynav.core.ros.converters import time_from_msg
 from easynav.playground.demo.run_monitor import RunMonitor
+from easynav.system.ros.converters import time_from_msg
 
 
 @dataclass(frozen=True)

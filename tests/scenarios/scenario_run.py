@@ -207,7 +207,7 @@ class ScenarioRun:
         from rclpy.executors import SingleThreadedExecutor
         from scenario_monitor import ScenarioMonitor
 
-        from easynav.core.goals.goal_manager_client import GoalManagerClient
+        from easynav.system.goals.goal_manager_client import GoalManagerClient
 
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=self.domain_id)
@@ -445,8 +445,8 @@ class ScenarioRun:
     # ------------------------------------------------------------------ goals
     def send_goals(self, goals: list[tuple[float, float, float]]) -> float:
         """Send ``[(x, y, yaw)]`` in the map frame; wait until accepted. Returns the sim time."""
-        from easynav.core.goals.goal_client_state import GoalClientState as S
         from easynav.core.types import Header, Pose, PoseStamped
+        from easynav.system.goals.goal_client_state import GoalClientState as S
 
         stamp = self.monitor.sim_now()
         self.client.send_goals(

@@ -18,8 +18,8 @@ import math
 import pytest
 from scenario_run import ScenarioRun, scenario_params, speed_up, world_file
 
-from easynav.core.goals.goal_client_state import GoalClientState
-from easynav.core.system.easynav_runtime import EasyNavRuntime
+from easynav.system.easynav_runtime import EasyNavRuntime
+from easynav.system.goals.goal_client_state import GoalClientState
 
 pytestmark = [
     pytest.mark.slow,

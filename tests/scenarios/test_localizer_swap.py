@@ -19,8 +19,8 @@ import pytest
 import yaml
 from scenario_run import HOME_MAP, ScenarioRun, scenario_params, speed_up
 
-from easynav.core.goals.goal_client_state import GoalClientState
-from easynav.core.system.easynav_runtime import EasyNavRuntime
+from easynav.system.easynav_runtime import EasyNavRuntime
+from easynav.system.goals.goal_client_state import GoalClientState
 
 pytest.importorskip("filterpy", reason="the fusion localizer needs easynav-localizers[fusion]")
 

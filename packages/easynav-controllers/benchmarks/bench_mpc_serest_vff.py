@@ -23,10 +23,10 @@ from easynav.controllers.vff_controller import VffController
 from easynav.core.benchmarking import BenchRow, add_json_option, percentiles, report
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
-from easynav.core.plugins.colision_checker import ColisionChecker
 from easynav.core.robot import RobotLimits
 from easynav.core.sensors import PointPerception
 from easynav.core.types import Costmap2D, Header, Odometry, Path, Pose
+from easynav.system.colision_checker import ColisionChecker
 
 CYCLES = 300
 

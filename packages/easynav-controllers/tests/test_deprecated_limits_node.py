@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from easynav.core.testing.system_fixtures import system_params
+from easynav.system.testing.system_fixtures import system_params
 
 pytestmark = pytest.mark.ros
 

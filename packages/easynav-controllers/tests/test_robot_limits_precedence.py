@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from rclpy.parameter import Parameter
 
-from easynav.core.testing.system_fixtures import system_params, wait_for
+from easynav.system.testing.system_fixtures import system_params, wait_for
 
 pytestmark = pytest.mark.ros
 

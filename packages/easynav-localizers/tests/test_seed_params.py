@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from easynav.core.plugins.plugin_kinds import LOCALIZER
-from easynav.core.testing.params_section_plugin import plugin_from_params_section
+from easynav.system.testing.params_section_plugin import plugin_from_params_section
 
 pytestmark = pytest.mark.ros
 

@@ -28,9 +28,9 @@ def test_topics_and_savemap(ros, tmp_path, monkeypatch):
     from std_srvs.srv import Trigger
     from visualization_msgs.msg import Marker
 
-    from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
     from easynav.maps.navmap import navmap_maps_manager
     from easynav.maps.ros_converters import occupancy_grid_to_msg
+    from easynav.system.sensors.converters.point_cloud2 import point_cloud2_from_points
 
     pixels = np.full((10, 20), 254, dtype=np.uint8)
     pixels[0, :] = 0

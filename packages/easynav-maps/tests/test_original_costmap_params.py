@@ -40,7 +40,7 @@ maps_manager_node:
 
 def test_original_section_configures_manager_and_filters(tmp_path):
     rclpy = pytest.importorskip("rclpy")
-    from easynav.core.system.node_parameters import NodeParameters
+    from easynav.system.node_parameters import NodeParameters
 
     pixels = np.full((40, 40), 254, np.uint8)
     pixels[20, :] = 0

@@ -22,9 +22,9 @@ def test_incoming_cloud_and_grid_replace_the_bonxai_map(ros):
     from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
     from sensor_msgs.msg import PointCloud2
 
-    from easynav.core.ros.plugin_endpoints import latched_qos
-    from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
+    from easynav.core.plugins.plugin_endpoints import latched_qos
     from easynav.maps.ros_converters import occupancy_grid_from_msg, occupancy_grid_to_msg
+    from easynav.system.sensors.converters.point_cloud2 import point_cloud2_from_points
 
     namespace = "voxel_ros_test"
     context = PluginContext(

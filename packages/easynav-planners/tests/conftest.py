@@ -1,4 +1,4 @@
-"""The shared `ros` fixture (easynav.core.testing) with a node named as this plugin's host."""
+"""The shared `ros` fixture (easynav.system.testing) with a node named as this plugin's host."""
 
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from easynav.core.testing.system_fixtures import system_params, wait_for
+from easynav.system.testing.system_fixtures import system_params, wait_for
 
 pytestmark = pytest.mark.ros
 

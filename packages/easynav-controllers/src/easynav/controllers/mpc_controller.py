@@ -288,7 +288,7 @@ class MPCController(ControllerMethodBase):
     def _publish_prediction(self, optimizer, u, pose, path: Path, now: float) -> None:
         if self._path_pub is None:
             return
-        from easynav.core.ros.converters import path_to_msg
+        from easynav.system.ros.converters import path_to_msg
 
         states = optimizer.predict(u, pose)
         prediction = Path.from_xy_yaw(states, Header(now, path.header.frame_id))

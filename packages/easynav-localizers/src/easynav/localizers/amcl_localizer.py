@@ -373,7 +373,7 @@ class AMCLLocalizer(LocalizerMethodBase):
             return
         from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped
 
-        from easynav.core.ros.converters import header_to_msg, pose_to_msg
+        from easynav.system.ros.converters import header_to_msg, pose_to_msg
 
         tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
         odom = self._odom
@@ -396,7 +396,7 @@ class AMCLLocalizer(LocalizerMethodBase):
         from nav_msgs.msg import Odometry as OdometryMsg
         from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-        from easynav.core.tf import TFBroadcaster
+        from easynav.system.tf import TFBroadcaster
 
         node = self.context.node
         base = f"{node.get_fully_qualified_name().rstrip('/')}/{self.plugin_name}"
@@ -432,6 +432,6 @@ class AMCLLocalizer(LocalizerMethodBase):
             broadcaster.destroy()
 
     def _on_odom(self, msg) -> None:
-        from easynav.core.ros.converters import odometry_from_msg
+        from easynav.system.ros.converters import odometry_from_msg
 
         self.set_odometry(odometry_from_msg(msg))

@@ -387,7 +387,7 @@ class FusionLocalizer(LocalizerMethodBase):
         publisher = self._ros.get(prefix)
         if publisher is None:
             return
-        from easynav.core.ros.converters import odometry_to_msg
+        from easynav.system.ros.converters import odometry_to_msg
 
         if publisher.get_subscription_count() > 0:
             publisher.publish(odometry_to_msg(odometry))
@@ -396,7 +396,7 @@ class FusionLocalizer(LocalizerMethodBase):
                 and fix_pub.get_subscription_count() > 0):
             from sensor_msgs.msg import NavSatFix, NavSatStatus
 
-            from easynav.core.ros.converters import header_to_msg
+            from easynav.system.ros.converters import header_to_msg
 
             filt = self.filters["global_filter"]
             east = odometry.pose.x - filt.gnss_offset[0]
@@ -415,7 +415,7 @@ class FusionLocalizer(LocalizerMethodBase):
         from nav_msgs.msg import Odometry as OdometryMsg
         from sensor_msgs.msg import Imu, NavSatFix
 
-        from easynav.core.tf import TFBroadcaster
+        from easynav.system.tf import TFBroadcaster
 
         node = self.context.node
         sub_node = self.context.rt_node if self.context.rt_node is not None else node
@@ -436,8 +436,8 @@ class FusionLocalizer(LocalizerMethodBase):
                 node, local_buffer=get_tf_buffer(self.context.namespace))
 
     def _subscribe(self, sub_node, prefix, source, odometry_type, imu_type):
-        from easynav.core.ros.converters import odometry_from_msg
-        from easynav.core.sensors.converters.imu import imu_from_msg
+        from easynav.system.ros.converters import odometry_from_msg
+        from easynav.system.sensors.converters.imu import imu_from_msg
 
         name = source.name
         if source.kind == "imu":
@@ -456,7 +456,7 @@ class FusionLocalizer(LocalizerMethodBase):
         if source.kind == "pose":
             from geometry_msgs.msg import PoseWithCovarianceStamped
 
-            from easynav.core.ros.converters import pose_from_msg, time_from_msg
+            from easynav.system.ros.converters import pose_from_msg, time_from_msg
 
             def on_pose(msg):
                 self.add_odometry(prefix, name, Odometry(
@@ -467,7 +467,7 @@ class FusionLocalizer(LocalizerMethodBase):
                                                 on_pose, source.queue_size)
         from geometry_msgs.msg import TwistWithCovarianceStamped
 
-        from easynav.core.ros.converters import time_from_msg
+        from easynav.system.ros.converters import time_from_msg
 
         def on_twist(msg):
             t = msg.twist.twist

@@ -146,7 +146,7 @@ class GpsLocalizer(LocalizerMethodBase):
         nav_state.set(ROBOT_POSE, odometry)
         publisher = self._ros.get("odom")
         if publisher is not None:
-            from easynav.core.ros.converters import odometry_to_msg
+            from easynav.system.ros.converters import odometry_to_msg
 
             publisher.publish(odometry_to_msg(odometry))
 
@@ -165,9 +165,9 @@ class GpsLocalizer(LocalizerMethodBase):
         from rclpy.qos import qos_profile_sensor_data
         from sensor_msgs.msg import Imu, NavSatFix
 
-        from easynav.core.sensors.converters.imu import imu_from_msg
-        from easynav.core.sensors.converters.nav_sat_fix import gnss_from_msg
-        from easynav.core.tf import StaticTFBroadcaster
+        from easynav.system.sensors.converters.imu import imu_from_msg
+        from easynav.system.sensors.converters.nav_sat_fix import gnss_from_msg
+        from easynav.system.tf import StaticTFBroadcaster
 
         node = self.context.node
         qos = qos_profile_sensor_data

@@ -234,9 +234,9 @@ class GtsamLocalizer(LocalizerMethodBase):
         from nav_msgs.msg import Odometry as OdometryMsg
         from sensor_msgs.msg import Imu
 
-        from easynav.core.ros.converters import odometry_from_msg
-        from easynav.core.sensors.converters.imu import imu_from_msg
-        from easynav.core.tf import TFBroadcaster
+        from easynav.system.ros.converters import odometry_from_msg
+        from easynav.system.sensors.converters.imu import imu_from_msg
+        from easynav.system.tf import TFBroadcaster
 
         node = self.context.node
         sub_node = self.context.rt_node if self.context.rt_node is not None else node

@@ -632,7 +632,7 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
         if particles.get_subscription_count() > 0:
             from geometry_msgs.msg import PoseArray
 
-            from easynav.core.ros.converters import header_to_msg, pose_to_msg
+            from easynav.system.ros.converters import header_to_msg, pose_to_msg
 
             tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
             odom = self._odom
@@ -650,7 +650,7 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
             return
         from geometry_msgs.msg import PoseWithCovarianceStamped
 
-        from easynav.core.ros.converters import header_to_msg, pose_to_msg
+        from easynav.system.ros.converters import header_to_msg, pose_to_msg
 
         tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
         odom = self._odom

@@ -11,13 +11,13 @@ import array
 import numpy as np
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 
-from easynav.core.ros.converters import (
+from easynav.maps.occupancy_grid import OccupancyGrid
+from easynav.system.ros.converters import (
     header_from_msg,
     header_to_msg,
     pose_from_msg,
     pose_to_msg,
 )
-from easynav.maps.occupancy_grid import OccupancyGrid
 
 
 def occupancy_grid_to_msg(grid: OccupancyGrid) -> OccupancyGridMsg:

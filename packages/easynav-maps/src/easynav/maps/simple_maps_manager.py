@@ -11,7 +11,7 @@ import numpy as np
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import MAP, MAP_BASE, MAP_TIME
 from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError, Topic
-from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
+from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer

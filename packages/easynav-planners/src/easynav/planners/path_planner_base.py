@@ -177,6 +177,6 @@ class PathPlannerBase(PlannerMethodBase):
             )
         publisher = self._publisher
         if publisher is not None and publisher.get_subscription_count() > 0:
-            from easynav.core.ros.converters import path_to_msg
+            from easynav.system.ros.converters import path_to_msg
 
             publisher.publish(path_to_msg(path))

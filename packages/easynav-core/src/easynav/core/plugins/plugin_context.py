@@ -14,7 +14,7 @@ from easynav.core.robot import RobotGeometry, RobotLimits
 class ParameterAccess:
     """Declare-if-absent-and-read access to a node's parameters.
 
-    The ROS implementation lives in ``easynav.core.system.node_parameters``; :class:`DictParameters`
+    The ROS implementation lives in ``easynav.system.node_parameters``; :class:`DictParameters`
     serves tests and tools that run plugins without ROS.
     """
 

@@ -1,21 +1,20 @@
-"""Sensors: perceptions, perception handlers, the sensors manager and point operations.
+"""Perceptions: what the sensors give the plugins, and the operations on point sets.
 
 ``PointPerception`` (LaserScan and PointCloud2 sensors) and :class:`PointPerceptionsOps` are the
 cross-team contract: plugins read ``nav_state.get_no_group(PointPerception)`` and process it with
-``PointPerceptionsOps(...).fuse(...).filter(...).downsample(...).as_points()``.
+``PointPerceptionsOps(...).fuse(...).filter(...).downsample(...).as_points()``. The runtime's
+sensors manager (``easynav.system.sensors``) fills NavState with them from ROS topics; a script
+can make them directly from numpy arrays.
 """
 
 from easynav.core.sensors.detection import Detection
 from easynav.core.sensors.detections_perception import DetectionsPerception
-from easynav.core.sensors.errors import PerceptionConversionError, SensorsConfigurationError
 from easynav.core.sensors.gnss_perception import GNSSPerception
 from easynav.core.sensors.image_perception import ImagePerception
 from easynav.core.sensors.imu_perception import ImuPerception
 from easynav.core.sensors.odometry_perception import OdometryPerception
-from easynav.core.sensors.perception_handler import PerceptionHandler
 from easynav.core.sensors.point_perception import PointPerception
 from easynav.core.sensors.point_perceptions_ops import PointPerceptionsOps
-from easynav.core.sensors.sensors_manager import SensorsManager
 from easynav.core.sensors.voxel_grid import voxel_downsample, voxel_downsample_indices
 
 __all__ = [
@@ -25,12 +24,8 @@ __all__ = [
     "ImagePerception",
     "ImuPerception",
     "OdometryPerception",
-    "PerceptionConversionError",
-    "PerceptionHandler",
     "PointPerception",
     "PointPerceptionsOps",
-    "SensorsConfigurationError",
-    "SensorsManager",
     "voxel_downsample",
     "voxel_downsample_indices",
 ]

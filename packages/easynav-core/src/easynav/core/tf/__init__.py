@@ -1,9 +1,8 @@
-"""The TF buffer of EasyNav (tf2 has no PyPI wheel: this package replaces tf2 / tf2_ros).
+"""The TF buffer of EasyNav (tf2 has no PyPI wheel: this package replaces tf2's buffer).
 
-``get_tf_buffer()`` is the process-wide buffer that also holds the robot's :class:`TFInfo`;
-:class:`TFListener` fills it from ``tf``/``tf_static``; :class:`TFBroadcaster` and
-:class:`StaticTFBroadcaster` publish. ROS messages are imported lazily, so the buffer itself
-works (and is tested) without ROS.
+``get_tf_buffer()`` is the process-wide buffer that also holds the robot's :class:`TFInfo`. It is
+plain Python and works without ROS: a script fills it with ``set_transform``. In a running
+system the runtime's listener (``easynav.system.tf``) fills it from ``tf``/``tf_static``.
 """
 
 from easynav.core.tf.errors import (
@@ -12,8 +11,6 @@ from easynav.core.tf.errors import (
     FrameLookupError,
     TransformError,
 )
-from easynav.core.tf.static_tf_broadcaster import StaticTFBroadcaster
-from easynav.core.tf.tf_broadcaster import TFBroadcaster
 from easynav.core.tf.tf_buffer import TFBuffer
 from easynav.core.tf.tf_buffer_registry import (
     get_tf_buffer,
@@ -21,17 +18,13 @@ from easynav.core.tf.tf_buffer_registry import (
     set_default_tf_namespace,
 )
 from easynav.core.tf.tf_info import TFInfo
-from easynav.core.tf.tf_listener import TFListener
 
 __all__ = [
     "ConnectivityError",
     "ExtrapolationError",
     "FrameLookupError",
-    "StaticTFBroadcaster",
-    "TFBroadcaster",
     "TFBuffer",
     "TFInfo",
-    "TFListener",
     "TransformError",
     "get_tf_buffer",
     "reset_tf_buffers",

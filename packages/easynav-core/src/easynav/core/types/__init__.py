@@ -1,6 +1,6 @@
 """Native types held in NavState: plain dataclasses and numpy arrays, no ROS messages.
 
-ROS messages exist only at the node boundary (``easynav.core.ros.converters``).
+ROS messages exist only at the node boundary (``easynav.system.ros.converters``).
 """
 
 from easynav.core.types.costmap_2d import (

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
-from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
+from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
-from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
+from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import get_tf_buffer
 from easynav.maps.filtered_maps_manager import FilteredMapsManager
@@ -252,7 +252,7 @@ class NavMapMapsManager(FilteredMapsManager):
                          f"({self._navmap})")
 
     def _on_incoming_pc2_map(self, msg) -> None:
-        from easynav.core.sensors.converters.point_cloud2 import points_from_point_cloud2
+        from easynav.system.sensors.converters.point_cloud2 import points_from_point_cloud2
 
         try:
             points, _ = points_from_point_cloud2(msg)

@@ -89,7 +89,7 @@ def layer_to_point_cloud2(navmap: NavMap, layer: str, frame_id: str, stamp: floa
     float32 field named ``layer`` (offset 12, point_step 16)."""
     from sensor_msgs.msg import PointCloud2, PointField
 
-    from easynav.core.tf.ros_conversion import seconds_to_stamp
+    from easynav.system.tf.ros_conversion import seconds_to_stamp
 
     msg = PointCloud2()
     msg.header.frame_id = frame_id

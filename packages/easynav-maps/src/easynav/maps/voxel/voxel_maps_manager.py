@@ -11,7 +11,7 @@ import numpy as np
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
-from easynav.core.ros.plugin_endpoints import PluginEndpoints, latched_qos
+from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
 from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.sensors.point_perceptions_ops import transform_points
 from easynav.core.tf import TransformError, get_tf_buffer
@@ -367,7 +367,7 @@ class VoxelMapsManager(CostmapMapsManager):
 
     def _on_incoming_cloud(self, msg) -> None:
         """incoming_pc2_map: the map rebuilt from the cloud, in the map frame (non-RT thread)."""
-        from easynav.core.sensors.converters.point_cloud2 import points_from_point_cloud2
+        from easynav.system.sensors.converters.point_cloud2 import points_from_point_cloud2
 
         stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
         frame = msg.header.frame_id
@@ -408,7 +408,7 @@ class VoxelMapsManager(CostmapMapsManager):
             return
         if publisher.get_subscription_count() == 0 and self._last_cloud > -math.inf:
             return  # the latched first cloud is sent; later ones only for a listener
-        from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
+        from easynav.system.sensors.converters.point_cloud2 import point_cloud2_from_points
 
         frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
         publisher.publish(point_cloud2_from_points(self._voxels.occupied_centres(), frame, now))

@@ -67,7 +67,7 @@ def _domain_for_run(domain_id: int | None):
     DomainReservation (``.domain``; ``release()``) or None with the given id."""
     if domain_id is not None:
         return None
-    from easynav.core.testing.dds_isolation import DomainReservation
+    from easynav.system.testing.dds_isolation import DomainReservation
 
     return DomainReservation.acquire(f"demo/{os.getpid()}")
 

@@ -145,8 +145,8 @@ class DemoRun:
         self.executor = SingleThreadedExecutor(context=self.context)
 
     def _start(self) -> None:
-        from easynav.core.goals.goal_manager_client import GoalManagerClient
         from easynav.playground.demo.run_monitor import RunMonitor
+        from easynav.system.goals.goal_manager_client import GoalManagerClient
 
         for child in self.children:
             child.start()
@@ -164,8 +164,8 @@ class DemoRun:
         )
 
     def _send_waypoints(self) -> None:
-        from easynav.core.goals.goal_client_state import GoalClientState
         from easynav.core.types import Header, Pose, PoseStamped
+        from easynav.system.goals.goal_client_state import GoalClientState
 
         stamp = self.monitor.get_clock().now().nanoseconds * 1e-9
         goals = [
@@ -207,7 +207,7 @@ class DemoRun:
 
     def _mark_reached(self, state, feedback) -> None:
         """Stamp the waypoints the goal manager no longer lists as reached (the true time)."""
-        from easynav.core.goals.goal_client_state import GoalClientState
+        from easynav.system.goals.goal_client_state import GoalClientState
 
         remaining = self.monitor.remaining_goals
         if feedback is not None and feedback.goals.goals:
@@ -333,7 +333,7 @@ class DemoRun:
 def controller_cycle_from_log(log_path: Path) -> dict | None:
     """The controller's update_rt cost from the line EasyNav's controller_node logs when it
     is deactivated (the last one, if it was activated more than once); None when absent."""
-    from easynav.core.system.cycle_times import DESCRIPTION_PATTERN
+    from easynav.system.cycle_times import DESCRIPTION_PATTERN
 
     try:
         text = log_path.read_text(errors="replace")

@@ -251,10 +251,10 @@ def _run(description, runs, children, domain, record, output_png, timeout, ready
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
-    from easynav.core.goals.goal_client_state import GoalClientState as S
-    from easynav.core.goals.goal_manager_client import GoalManagerClient
     from easynav.core.types import Header, Pose, PoseStamped
     from easynav.playground.demo.run_monitor import RunMonitor
+    from easynav.system.goals.goal_client_state import GoalClientState as S
+    from easynav.system.goals.goal_manager_client import GoalManagerClient
 
     context = rclpy.Context()
     saved_range = os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import yaml
 
-from easynav.core.cli.params_file import load_ros_yaml
+from easynav.system.cli.params_file import load_ros_yaml
 
 SIMPLE_MAPS_MANAGER = "easynav_simple_maps_manager/SimpleMapsManager"
 #: Maps managers that load a ROS map-server YAML through ``package`` / ``map_path_file``.

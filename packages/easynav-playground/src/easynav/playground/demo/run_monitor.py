@@ -17,10 +17,10 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 
-from easynav.core.goals.ros_conversion import goal_topics_qos
-from easynav.core.ros.converters import time_from_msg
 from easynav.core.types import quaternion_to_yaw
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
+from easynav.system.goals.ros_conversion import goal_topics_qos
+from easynav.system.ros.converters import time_from_msg
 
 
 def _yaw(q) -> float:

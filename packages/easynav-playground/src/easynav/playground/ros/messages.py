@@ -11,9 +11,9 @@ from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from sensor_msgs.msg import Imu, LaserScan, NavSatFix
 
-from easynav.core.ros.converters import time_to_msg
 from easynav.playground.sim.laser_scanner import LaserScanner
 from easynav.playground.sim.world import World
+from easynav.system.ros.converters import time_to_msg
 
 
 def stamp_msg(seconds: float) -> Time:

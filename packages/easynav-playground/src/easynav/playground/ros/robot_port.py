@@ -10,9 +10,9 @@ from geometry_msgs.msg import Pose2D, Twist, TwistStamped
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool, String
 
-from easynav.core.tf import StaticTFBroadcaster, TFBroadcaster
 from easynav.playground.ros import messages
 from easynav.playground.sim import Collision, GnssReceiver, ImuSensor, Simulation, Terrain
+from easynav.system.tf import StaticTFBroadcaster, TFBroadcaster
 
 _RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 _LATCHED = QoSProfile(
@@ -179,7 +179,7 @@ class RobotPort:
         )
 
     def publish_cloud(self, stamp: float, points: np.ndarray) -> None:
-        from easynav.core.sensors.converters.point_cloud2 import point_cloud2_from_points
+        from easynav.system.sensors.converters.point_cloud2 import point_cloud2_from_points
 
         self._cloud_pub.publish(point_cloud2_from_points(points, self.frames["lidar_frame"], stamp))
 

@@ -54,7 +54,7 @@ class RecoveryTopics:
         changed = signature != self._last_signature
         if not ((changed and elapsed >= self.MIN_PERIOD) or elapsed >= self.MAX_PERIOD):
             return False
-        from easynav.core.ros.converters import diagnostic_to_msg, time_to_msg
+        from easynav.system.ros.converters import diagnostic_to_msg, time_to_msg
 
         array = self._array_type()
         array.header.stamp = time_to_msg(stamp)
@@ -68,7 +68,7 @@ class RecoveryTopics:
         """Publish one mitigation report (only with subscribers)."""
         if self.mitigation_publisher.get_subscription_count() == 0:
             return
-        from easynav.core.ros.converters import time_to_msg
+        from easynav.system.ros.converters import time_to_msg
 
         msg = self._log_type()
         msg.stamp = time_to_msg(stamp)

@@ -191,9 +191,9 @@ def in_box(points: np.ndarray, lower, upper) -> np.ndarray:
 def zone_markers(zone: CollisionZone) -> Any:
     """The original's debug markers of ``zone``: a visualization_msgs/MarkerArray with a
     DELETEALL, the box (CUBE, id 1) and the points (SPHERE_LIST, id 2), namespace
-    ``collision_zone`` (:func:`~easynav.core.ros.collision_markers.collision_markers`). Needs
+    ``collision_zone`` (:func:`~easynav.system.ros.collision_markers.collision_markers`). Needs
     visualization_msgs (ImportError otherwise)."""
-    from easynav.core.ros.collision_markers import collision_markers
+    from easynav.system.ros.collision_markers import collision_markers
 
     return collision_markers(
         zone.frame, zone.stamp, zone.lower, zone.upper, zone.points, zone.imminent,

@@ -1,0 +1,72 @@
+"""PlannerNode: hosts the planner and guards the path it produces."""
+
+from __future__ import annotations
+
+from easynav.core.diagnostics import write_diagnostic
+from easynav.core.plugins.plugin_kinds import PLANNER
+from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Header, Path
+from easynav.system.component_node import ComponentNode
+
+
+class PlannerNode(ComponentNode):
+    """planner_node: ``planner_types`` (at most one), ``<alias>.*``.
+
+    The planner runs at its ``freq``, and at once when ``goals`` changed since its last run.
+    A goal the planner rejects (``reject_goal``) ends the mission with the planner's reason.
+    A path with a non-finite pose is discarded: ``path`` is left empty, so no controller follows
+    it, and ``diagnostics.path`` is ERROR (hardware_id planner) until a finite path comes.
+
+    Thread contract: ``cycle`` in the non-RT thread.
+    """
+
+    KIND = PLANNER
+    TYPES_PARAMETER = "planner_types"
+    MAX_PLUGINS = 1
+    MONITOR_RT = False
+
+    def __init__(self, namespace, system, **kwargs):
+        super().__init__("planner_node", namespace, system, **kwargs)
+        self._planned_goals = None
+        self._path_rejected = False
+
+    def cycle(self) -> None:
+        """Plan when due or forced by new goals. Non-RT thread."""
+        if not self.active:
+            return
+        goals = self.nav_state.get("goals") if self.nav_state.has("goals") else None
+        force = goals is not self._planned_goals
+        self._planned_goals = goals
+        for lp, _ok in self.run_scheduled(rt=False, force=force):
+            rejection = lp.plugin.take_goal_rejection()
+            if rejection and goals is not None and len(goals) > 0:
+                self.get_logger().warning(f"goal rejected by {lp.alias}: {rejection}")
+                self.system.services["requests"].post_abort(rejection)
+            self._check_path(self.now_seconds())
+
+    def _check_path(self, now: float) -> None:
+        if not self.nav_state.has("path"):
+            return
+        path = self.nav_state.get("path", Path)
+        if path.is_finite():
+            if self._path_rejected:
+                self._path_rejected = False
+                write_diagnostic(
+                    self.nav_state,
+                    "path",
+                    DiagnosticStatus(DiagnosticLevel.OK, "path", "finite path", "planner"),
+                )
+            return
+        self.nav_state.set("path", Path(Header(now, path.header.frame_id), []))
+        if not self._path_rejected:
+            self._path_rejected = True
+            self.get_logger().error("the planner produced a path with a non-finite pose: discarded")
+            write_diagnostic(
+                self.nav_state,
+                "path",
+                DiagnosticStatus(
+                    DiagnosticLevel.ERROR,
+                    "path",
+                    "path with a non-finite pose discarded",
+                    "planner",
+                ),
+            )

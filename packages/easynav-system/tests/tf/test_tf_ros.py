@@ -1,0 +1,146 @@
+"""TF over real topics: broadcasters, listener, latched statics, namespaces. One process."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from easynav.core.tf import TFBuffer
+from easynav.core.types import Header, Transform, TransformStamped
+from easynav.system.tf import StaticTFBroadcaster, TFBroadcaster, TFListener
+
+
+def _ts(parent: str, child: str, stamp: float, x: float) -> TransformStamped:
+    return TransformStamped(
+        header=Header(stamp=stamp, frame_id=parent),
+        child_frame_id=child,
+        transform=Transform(np.array((x, 0.0, 0.0)), np.array((0.0, 0.0, 0.0, 1.0))),
+    )
+
+
+def test_broadcast_dynamic_and_static_transforms_reach_the_listener(ros_local):
+    publisher = ros_local.create_node("tf_pub")
+    listener_node = ros_local.create_node("tf_sub")
+    buffer = TFBuffer()
+    listener = TFListener(listener_node, buffer)
+    static = StaticTFBroadcaster(publisher)
+    dynamic = TFBroadcaster(publisher)
+    static.send_transform(_ts("base_link", "laser", 0.0, 0.25))
+    static.send_transform(_ts("map", "odom", 0.0, 10.0))
+    ros_local.spin_until(lambda: publisher.count_subscribers("tf") > 0)
+    dynamic.send_transform([_ts("odom", "base_link", 100.0, 1.0)])
+    dynamic.send_transform(_ts("odom", "base_link", 101.0, 2.0))
+    assert ros_local.spin_until(lambda: buffer.can_transform("map", "laser", 101.0), 5.0)
+    got = buffer.lookup_transform("map", "laser", 100.5)
+    np.testing.assert_allclose(got.transform.translation, (11.75, 0, 0))
+    assert "static" in buffer.all_frames_as_string()
+    listener.destroy()
+
+
+def test_a_late_listener_still_gets_every_static_transform(ros_local):
+    publisher = ros_local.create_node("static_pub")
+    static = StaticTFBroadcaster(publisher)
+    static.send_transform(_ts("base_link", "laser", 0.0, 0.25))
+    static.send_transform(_ts("base_link", "camera", 0.0, 0.5))  # republishes both
+    ros_local.spin_for(0.2)
+    late = ros_local.create_node("late_listener")
+    buffer = TFBuffer()
+    TFListener(late, buffer)
+    assert ros_local.spin_until(
+        lambda: buffer.frame_exists("laser") and buffer.frame_exists("camera"), 5.0
+    )
+    assert buffer.lookup_transform("camera", "laser").transform.translation[0] == -0.25
+
+
+def test_namespaced_robots_keep_separate_trees(ros_local):
+    """Relative topics: /r1/tf and /r2/tf. Each robot's listener sees only its own tree."""
+    r1 = ros_local.create_node("pub", namespace="r1")
+    r2 = ros_local.create_node("pub", namespace="r2")
+    buffers = {"r1": TFBuffer(), "r2": TFBuffer()}
+    TFListener(ros_local.create_node("sub", namespace="r1"), buffers["r1"])
+    TFListener(ros_local.create_node("sub", namespace="r2"), buffers["r2"])
+    StaticTFBroadcaster(r1).send_transform(_ts("r1/base_link", "r1/laser", 0.0, 1.0))
+    StaticTFBroadcaster(r2).send_transform(_ts("r2/base_link", "r2/laser", 0.0, 2.0))
+    assert ros_local.spin_until(
+        lambda: buffers["r1"].frame_exists("r1/laser") and buffers["r2"].frame_exists("r2/laser")
+    )
+    ros_local.spin_for(0.1)
+    assert buffers["r1"].frames() == ["r1/base_link", "r1/laser"]
+    assert buffers["r2"].frames() == ["r2/base_link", "r2/laser"]
+
+
+def test_local_buffer_gets_broadcast_transforms_without_a_round_trip(ros_local):
+    node = ros_local.create_node("localizer")
+    buffer = TFBuffer()
+    TFBroadcaster(node, local_buffer=buffer).send_transform(_ts("map", "odom", 5.0, 3.0))
+    assert buffer.lookup_transform("map", "odom", 5.0).transform.translation[0] == 3.0
+
+
+def test_a_nan_transform_is_refused_before_it_is_published(ros_local):
+    node = ros_local.create_node("bad_pub")
+    broadcaster = TFBroadcaster(node)
+    with pytest.raises(ValueError, match="'map' -> 'odom' is not finite"):
+        broadcaster.send_transform(_ts("map", "odom", 1.0, math.nan))
+    with pytest.raises(TypeError, match="TransformStamped"):
+        broadcaster.send_transform([object()])
+
+
+def test_a_nan_transform_on_the_wire_is_rejected_by_the_listener(ros_local, caplog):
+    from geometry_msgs.msg import TransformStamped as TransformStampedMsg
+    from tf2_msgs.msg import TFMessage
+
+    publisher = ros_local.create_node("raw_pub")
+    raw = publisher.create_publisher(TFMessage, "tf", 10)
+    buffer = TFBuffer()
+    TFListener(ros_local.create_node("sub"), buffer)
+    good, bad = TransformStampedMsg(), TransformStampedMsg()
+    for msg, child in ((good, "base_link"), (bad, "laser")):
+        msg.header.frame_id = "odom"
+        msg.header.stamp.sec = 10
+        msg.child_frame_id = child
+        msg.transform.rotation.w = 1.0
+    bad.transform.translation.x = math.nan
+    ros_local.spin_until(lambda: publisher.count_subscribers("tf") > 0)
+    raw.publish(TFMessage(transforms=[good, bad]))
+    assert ros_local.spin_until(lambda: buffer.frame_exists("base_link"))
+    assert not buffer.frame_exists("laser")
+    assert "'odom' -> 'laser'" in caplog.text
+
+
+def test_time_jumping_back_clears_the_buffer_so_the_new_run_is_used(ros_local):
+    """A simulator restarted under a running system: its clock goes back to zero. Without the
+    clear, the old run's transforms (stamped up to 60 s) would be the newest for the cache
+    window and every new one, stamped from 0 s, refused as too old."""
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+
+    listener_node = ros_local.create_node(
+        "sim_listener", parameter_overrides=[Parameter("use_sim_time", value=True)]
+    )
+    clock_node = ros_local.create_node("sim_clock")
+    clock_pub = clock_node.create_publisher(Clock, "/clock", 10)
+    buffer = TFBuffer()
+    listener = TFListener(listener_node, buffer)
+    dynamic = TFBroadcaster(clock_node)
+
+    def publish_clock(seconds: float) -> None:
+        msg = Clock()
+        msg.clock.sec = int(seconds)
+        clock_pub.publish(msg)
+
+    assert ros_local.spin_until(lambda: clock_pub.get_subscription_count() > 0)
+    assert ros_local.spin_until(lambda: clock_node.count_subscribers("tf") > 0)
+    publish_clock(60.0)
+    assert ros_local.spin_until(lambda: listener_node.get_clock().now().nanoseconds == 60e9)
+    dynamic.send_transform(_ts("odom", "base_link", 60.0, 5.0))
+    assert ros_local.spin_until(lambda: buffer.can_transform("odom", "base_link", 60.0))
+
+    publish_clock(1.0)  # the simulator restarted
+    assert ros_local.spin_until(lambda: listener_node.get_clock().now().nanoseconds == 1e9)
+    assert not buffer.frame_exists("base_link")
+    dynamic.send_transform(_ts("odom", "base_link", 1.0, 0.5))
+    assert ros_local.spin_until(lambda: buffer.can_transform("odom", "base_link", 1.0))
+    assert buffer.lookup_transform("odom", "base_link").transform.translation[0] == 0.5
+    listener.destroy()
