@@ -19,9 +19,9 @@ REPO = Path(__file__).resolve().parents[2]
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.ros,
-    # Builds the interfaces' wheel (rosidl code generation) and installs two distributions into a
-    # fresh venv: about a minute on a quiet machine; at a load of 20 (a soak beside the suite) it passed the
-    # suite's 300 s watchdog while still generating messages.
+    # Builds the interfaces' wheel (rosidl code generation) and installs three distributions into
+    # a fresh venv: about a minute on a quiet machine; at a load of 20 (a soak beside the suite)
+    # it passed the suite's 300 s watchdog while still generating messages.
     pytest.mark.timeout(900),
 ]
 
