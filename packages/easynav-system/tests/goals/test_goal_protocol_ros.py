@@ -13,9 +13,8 @@ from goal_test_helpers import control, goal, request, set_robot
 
 from easynav.system.goals import GoalManagerParams, GoalManagerStatus
 from easynav.system.goals import NavigationControlType as T
-from easynav.system.goals.goal_client_error import GoalClientError
 from easynav.system.goals.goal_client_state import GoalClientState as S
-from easynav.system.goals.goal_manager_client import GoalManagerClient
+from easynav.system.goals.goal_manager_client import GoalClientError, GoalManagerClient
 
 pytestmark = pytest.mark.ros
 

@@ -6,10 +6,17 @@ import time
 from collections.abc import Sequence
 
 from easynav.core.plugins import MethodBase, Param
-from easynav.faulty.injected_fault_error import InjectedFaultError
 
 #: The fault name that means "never inject anything" (the default).
 NO_FAULT = "none"
+
+
+class InjectedFaultError(RuntimeError):
+    """Raised on purpose by a Faulty plugin whose ``fault`` is ``throw``.
+
+    A distinct type, so a test or a log reader can tell an injected failure from a real bug.
+    """
+
 
 
 class FaultInjector:

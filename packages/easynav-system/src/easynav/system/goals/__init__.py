@@ -10,9 +10,8 @@ messages) is usable and testable without rclpy. The ROS pieces live in their mod
 
 from easynav.system.goals.distance_tracker import DistanceTracker
 from easynav.system.goals.goal_manager import GoalManager
-from easynav.system.goals.goal_manager_info import GoalManagerInfo
+from easynav.system.goals.goal_manager_info import GoalManagerInfo, GoalManagerStatus
 from easynav.system.goals.goal_manager_params import GoalManagerParams
-from easynav.system.goals.goal_manager_status import GoalManagerStatus
 from easynav.system.goals.navigation_control import NavigationControl
 from easynav.system.goals.navigation_control_type import NavigationControlType
 from easynav.system.goals.protocol import NAVIGATION_ACTIVE, NAVIGATION_IDLE, SYSTEM_USER_ID

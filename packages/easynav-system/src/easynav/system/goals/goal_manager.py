@@ -20,9 +20,8 @@ from easynav.system.goals.goal_geometry import (
     xy_distance,
     yaw_distance,
 )
-from easynav.system.goals.goal_manager_info import GoalManagerInfo
+from easynav.system.goals.goal_manager_info import GoalManagerInfo, GoalManagerStatus
 from easynav.system.goals.goal_manager_params import GoalManagerParams
-from easynav.system.goals.goal_manager_status import GoalManagerStatus
 from easynav.system.goals.navigation_control import NavigationControl
 from easynav.system.goals.navigation_control_type import NavigationControlType as T
 

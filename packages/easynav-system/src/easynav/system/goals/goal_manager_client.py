@@ -12,7 +12,6 @@ from geometry_msgs.msg import PoseStamped as PoseStampedMsg
 from rclpy.clock import Clock, ClockType
 
 from easynav.core.types import Goals, Header, PoseStamped
-from easynav.system.goals.goal_client_error import GoalClientError
 from easynav.system.goals.goal_client_state import GoalClientState as S
 from easynav.system.goals.navigation_control import NavigationControl
 from easynav.system.goals.navigation_control_type import NavigationControlType as T
@@ -31,6 +30,14 @@ from easynav.system.ros.converters import pose_stamped_from_msg
 
 #: Seconds without an answer after which a REQUEST is sent again (steady clock).
 REPEAT_PERIOD = 1.0
+
+
+class GoalClientError(RuntimeError):
+    """Raised by :class:`GoalManagerClient` for a command its current state does not allow
+    (e.g. sending goals after the navigation ended without ``reset()``); the message names the
+    state and what to do.
+    """
+
 
 
 class GoalManagerClient:

@@ -3,9 +3,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import IntEnum
 
 from easynav.core.types import Goals
-from easynav.system.goals.goal_manager_status import GoalManagerStatus
+
+
+class GoalManagerStatus(IntEnum):
+    """Whether the goal manager has a mission (values of GoalManagerInfo.msg)."""
+
+    IDLE = 0
+    ACTIVE = 1
 
 
 @dataclass(slots=True)

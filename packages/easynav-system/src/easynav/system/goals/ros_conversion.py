@@ -10,8 +10,7 @@ from easynav_interfaces.msg import GoalManagerInfo as GoalManagerInfoMsg
 from easynav_interfaces.msg import NavigationControl as NavigationControlMsg
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from easynav.system.goals.goal_manager_info import GoalManagerInfo
-from easynav.system.goals.goal_manager_status import GoalManagerStatus
+from easynav.system.goals.goal_manager_info import GoalManagerInfo, GoalManagerStatus
 from easynav.system.goals.navigation_control import NavigationControl
 from easynav.system.goals.navigation_control_type import NavigationControlType
 from easynav.system.goals.protocol import QUEUE_DEPTH

@@ -11,8 +11,7 @@ from easynav.system.safety.configuration_fingerprint import (
     format_value,
     ros_log_dir,
 )
-from easynav.system.safety.heartbeat_fields import HeartbeatFields
-from easynav.system.safety.heartbeat_state import HeartbeatState
+from easynav.system.safety.heartbeat_state import HeartbeatFields, HeartbeatState
 from easynav.system.safety.parameter_freeze import ParameterFreeze
 from easynav.system.safety.pose_age_check import PoseAgeCheck
 from easynav.system.safety.realtime import (

@@ -1,10 +1,25 @@
-"""HeartbeatState: when the RT cycle publishes a heartbeat, and what it contains."""
+"""HeartbeatState: when the RT cycle publishes a heartbeat; HeartbeatFields: what it contains."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
-from easynav.system.safety.heartbeat_fields import HeartbeatFields
+
+@dataclass(frozen=True, slots=True)
+class HeartbeatFields:
+    """Fields of a Heartbeat message except its header (the node stamps it when publishing).
+
+    ``sequence``: +1 per heartbeat (a gap means lost heartbeats); ``rt_status``: RT_OK,
+    RT_LATE or RT_ERROR; ``late_cycles``: late RT cycles since activation; ``safety_mode``;
+    ``configuration_hash``: the configuration fingerprint (SHA-256 hex).
+    """
+
+    sequence: int
+    rt_status: int
+    late_cycles: int
+    safety_mode: bool
+    configuration_hash: str
 
 
 class HeartbeatState:
