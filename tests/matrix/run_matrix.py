@@ -61,6 +61,17 @@ def load_results(path: Path) -> dict[str, dict]:
     return found
 
 
+def source_commit() -> str:
+    """The commit the runs use (short hash, ``+changes`` when the tree differs from it): a row
+    kept from an earlier part of the matrix says which code it ran."""
+    def git(*args: str) -> str:
+        done = subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True)
+        return done.stdout.strip() if done.returncode == 0 else ""
+
+    commit = git("rev-parse", "--short", "HEAD") or "unknown"
+    return commit + ("+changes" if git("status", "--porcelain", "--untracked-files=no") else "")
+
+
 def run_one(name: str, run_dir: Path, speed_up: float, worlds: tuple[str, ...]) -> int:
     """``--run-one``: run one combination here and print its row as one JSON line."""
     combo = next((c for c in combinations(worlds) if c.name == name), None)
@@ -130,6 +141,7 @@ def main(argv: list[str]) -> int:
     print(f"{len(combos)} combinations: {len(combos) - len(todo)} already in {results_path}, "
           f"{len(todo)} to run, {args.jobs} at a time", flush=True)
     started = datetime.now(timezone.utc)
+    commit = source_commit()
     work = Path(tempfile.mkdtemp(prefix="easynav-matrix-"))
     lock = threading.Lock()
     finished = [0]
@@ -139,6 +151,7 @@ def main(argv: list[str]) -> int:
         t0 = time.monotonic()
         row = _run_in_process(combo.name, work / f"{i:03d}", args)
         row["seconds"] = round(time.monotonic() - t0, 1)
+        row["commit"] = commit
         with lock:
             with results_path.open("a") as f:
                 f.write(json.dumps(row) + "\n")
@@ -158,6 +171,11 @@ def main(argv: list[str]) -> int:
         Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"])
         for c in combos if c.name in kept
     ]
+    commits: dict[str, int] = {}
+    for c in combos:
+        if c.name in kept:
+            key = kept[c.name].get("commit", "not recorded")
+            commits[key] = commits.get(key, 0) + 1
     header = "\n".join([
         "# Integration matrix",
         "",
@@ -173,6 +191,8 @@ def main(argv: list[str]) -> int:
         + ("the covering slice only (`--slice`)" if args.slice else "every combination")
         + (f" whose name contains {args.only}" if args.only else "")
         + f", worlds {args.worlds}: {len(outcomes)} of {len(combos)} runs done",
+        "- code of the rows: "
+        + (", ".join(f"{key} ({n} rows)" for key, n in sorted(commits.items())) or "none yet"),
     ])
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     Path(args.output).write_text(markdown(outcomes, header, unmatched))
