@@ -1,4 +1,5 @@
-"""SensorsManager: the logic of sensors_node (subscriptions, data age, diagnostics, fused cloud)."""
+"""SensorsManager: the logic of sensors_node (subscriptions, data age; diagnostics and fused
+cloud through their own objects)."""
 
 from __future__ import annotations
 
@@ -17,9 +18,8 @@ from easynav.core.sensors.point_perception import PointPerception
 from easynav.core.sensors.point_perceptions_ops import PointPerceptionsOps
 from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.tf import TFBuffer, get_tf_buffer
-from easynav.core.types import DiagnosticLevel, DiagnosticStatus
-from easynav.system.sensors.converters.point_cloud2 import point_cloud2_from_points
 from easynav.system.sensors.errors import PerceptionConversionError, SensorsConfigurationError
+from easynav.system.sensors.fused_cloud_publisher import FusedCloudPublisher
 from easynav.system.sensors.handler_registry import resolve_handler
 from easynav.system.sensors.handlers import LaserScanHandler, PointCloud2Handler
 from easynav.system.sensors.sensor_parameters import (
@@ -28,12 +28,8 @@ from easynav.system.sensors.sensor_parameters import (
     SENSOR_PARAMETERS,
 )
 from easynav.system.sensors.sensor_state import SensorState
+from easynav.system.sensors.sensors_diagnostics import SensorsDiagnostics
 
-DIAGNOSTICS_GROUP = "diagnostics"
-DIAGNOSTIC_NAME = "sensors"
-DIAGNOSTIC_KEY = f"{DIAGNOSTICS_GROUP}.{DIAGNOSTIC_NAME}"
-HARDWARE_ID = "sensors_node"
-PERCEPTIONS_TOPIC = "~/perceptions"
 SENSOR_QUEUE_DEPTH = 5
 # Handlers whose point output already keeps the PointPerception contract (and is measured).
 _TRUSTED = (LaserScanHandler, PointCloud2Handler)
@@ -77,10 +73,8 @@ class SensorsManager:
         self._throttle = WarningThrottle(period=5.0)
         self._pending_new: set[str] = set()
         self._flagged_new: set[str] = set()
-        self._publisher: Any = None
-        self._points_version = 0
-        self._published_version = -1
-        self._last_diagnostic: tuple[DiagnosticLevel, str] | None = None
+        self._cloud = FusedCloudPublisher()
+        self._diagnostics = SensorsDiagnostics()
 
     # -- lifecycle ------------------------------------------------------------------------------
     def configure(
@@ -126,9 +120,7 @@ class SensorsManager:
                     nav_state.add_to_group(state.group, state.sensor_id)
             if node is not None:
                 self._subscribe_all()
-                self._publisher = node.create_publisher(
-                    _point_cloud2_class(), PERCEPTIONS_TOPIC, _reliable_qos(1)
-                )
+                self._cloud.create(node)
         except Exception:
             self.cleanup()
             raise
@@ -220,9 +212,7 @@ class SensorsManager:
             if state.subscription is not None and node is not None:
                 node.destroy_subscription(state.subscription)
                 state.subscription = None
-        if self._publisher is not None and node is not None:
-            node.destroy_publisher(self._publisher)
-        self._publisher = None
+        self._cloud.destroy(node)
         if nav_state is not None:
             ours = {s.sensor_id for s in sensors}
             for group, members in nav_state.groups().items():
@@ -231,8 +221,7 @@ class SensorsManager:
             for state in sensors:
                 if state.stored is not None:
                     nav_state.erase(state.sensor_id)
-        self._last_diagnostic = None
-        self._published_version = -1
+        self._diagnostics.reset()
         self._throttle.reset()
 
     # -- data path (RT thread) --------------------------------------------------------------------
@@ -295,7 +284,7 @@ class SensorsManager:
             if fresh:
                 self._pending_new.add(sensor_id)
                 if isinstance(perception, PointPerception):
-                    self._points_version += 1
+                    self._cloud.points_changed()
 
     def _checked_points(
         self, sensor_id: str, state: SensorState, perception: PointPerception
@@ -347,7 +336,7 @@ class SensorsManager:
                 if stored is not None and stored.valid and now - stored.stamp > forget_time:
                     self._replace(state, valid=False, new_data=False)
                     if isinstance(stored, PointPerception):
-                        self._points_version += 1
+                        self._cloud.points_changed()
         return bool(arrived)
 
     def _replace(self, state: SensorState, **changes: Any) -> None:
@@ -361,8 +350,9 @@ class SensorsManager:
         """Diagnostics (on changes) and the fused cloud (while subscribed). Non-RT thread."""
         if self._nav_state is None:
             return
-        self._update_diagnostics(now)
-        self._publish_fused_cloud()
+        self._diagnostics.update(self._nav_state, self.sensor_status(now), self._forget_time)
+        # Looked up at each call, not bound once: tests and tools may wrap fused_points.
+        self._cloud.publish(self.fused_points)
 
     def sensor_status(self, now: float) -> dict[str, str]:
         """``{sensor_id: "ok" | "no_data" | "stale"}`` at ``now``. Any thread."""
@@ -379,42 +369,6 @@ class SensorsManager:
                 status[state.sensor_id] = "ok"
         return status
 
-    def _update_diagnostics(self, now: float) -> None:
-        status = self.sensor_status(now)
-        no_data = [s for s, v in status.items() if v == "no_data"]
-        stale = [s for s, v in status.items() if v == "stale"]
-        if no_data or stale:
-            level = DiagnosticLevel.WARN
-            parts = []
-            if no_data:
-                parts.append(f"no data: {', '.join(no_data)}")
-            if stale:
-                parts.append(
-                    f"stale (older than forget_time {self._forget_time:g} s): {', '.join(stale)}"
-                )
-            message = "; ".join(parts)
-        elif status:
-            level, message = DiagnosticLevel.OK, "all sensors up to date"
-        else:
-            level, message = DiagnosticLevel.OK, "no sensors configured"
-        if self._last_diagnostic == (level, message):
-            return
-        self._last_diagnostic = (level, message)
-        diagnostic = DiagnosticStatus(
-            level=level,
-            name=DIAGNOSTIC_NAME,
-            message=message,
-            hardware_id=HARDWARE_ID,
-            values={
-                "no_data": ", ".join(no_data),
-                "stale": ", ".join(stale),
-                "forget_time": f"{self._forget_time:g}",
-                "sensors": ", ".join(status),
-            },
-        )
-        self._nav_state.set(DIAGNOSTIC_KEY, diagnostic)
-        self._nav_state.add_to_group(DIAGNOSTICS_GROUP, DIAGNOSTIC_KEY)
-
     def fused_points(self) -> tuple[Any, str, float | None]:
         """``(points, frame, stamp)``: the valid ungrouped point perceptions of this manager,
         fused into ``robot_footprint_frame`` (what the navigation sees). Non-RT thread."""
@@ -428,18 +382,6 @@ class SensorsManager:
             }
         ops = PointPerceptionsOps(perceptions, tf_buffer=buffer, logger=self._logger).fuse(frame)
         return ops.as_points(), frame, ops.stamp
-
-    def _publish_fused_cloud(self) -> None:
-        publisher = self._publisher
-        if publisher is None or publisher.get_subscription_count() == 0:
-            self._published_version = -1  # a new subscriber gets a cloud at once
-            return
-        version = self._points_version
-        if version == self._published_version:
-            return
-        points, frame, stamp = self.fused_points()
-        publisher.publish(point_cloud2_from_points(points, frame, stamp or 0.0))
-        self._published_version = version
 
     # -- introspection ----------------------------------------------------------------------------
     @property
@@ -485,15 +427,3 @@ def _sensor_qos() -> Any:
         reliability=ReliabilityPolicy.BEST_EFFORT,
         durability=DurabilityPolicy.VOLATILE,
     )
-
-
-def _reliable_qos(depth: int) -> Any:
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
-
-    return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
-
-
-def _point_cloud2_class() -> type:
-    from sensor_msgs.msg import PointCloud2
-
-    return PointCloud2
