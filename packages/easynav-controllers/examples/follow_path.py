@@ -1,26 +1,27 @@
 """SimplePathFollower drives a simulated unicycle along an S-shaped path.
 
-python packages/easynav-controllers/examples/follow_path.py [output.png]
+    python packages/easynav-controllers/examples/follow_path.py [--plot output.png]
+
+SimplePathFollower is the algorithm inside the SimpleController plugin, called directly
+(``controllers_on_path.py`` drives the plugins). Prints the final error and the speeds;
+``--plot`` (with matplotlib) draws the trajectory.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
-import sys
-from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from easynav.controllers import ARRIVED, SimplePathFollower  # noqa: E402
-from easynav.core.robot import RobotLimits  # noqa: E402
+from easynav.controllers import ARRIVED, SimplePathFollower
+from easynav.core.robot import RobotLimits
 
 
 def main() -> None:
-    output = Path(sys.argv[1]) if len(sys.argv) > 1 else Path("follow_path.png")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--plot", metavar="PNG", help="draw the trajectory (matplotlib)")
+    args = parser.parse_args()
     xs = np.arange(0.0, 6.01, 0.2)
     path = np.column_stack((xs, np.sin(xs), np.zeros_like(xs)))
     path[-1, 2] = math.pi / 2  # finish facing +y
@@ -41,13 +42,23 @@ def main() -> None:
     print(f"{state} after {t:.1f} s: {error:.3f} m from the end, yaw {yaw:.3f} rad")
     print(f"top speed {trace[:, 2].max():.2f} m/s, mean {trace[:, 2].mean():.2f} m/s")
 
+    if not args.plot:
+        return
+    try:
+        import matplotlib
+    except ImportError:
+        print("--plot: matplotlib is not installed")
+        return
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     fig, ax = plt.subplots(figsize=(9, 4))
     ax.plot(path[:, 0], path[:, 1], "o-", color="grey", markersize=3, label="path")
     ax.plot(trace[:, 0], trace[:, 1], "-", label="robot")
     ax.set_aspect("equal")
     ax.legend()
-    fig.savefig(output, dpi=80)
-    print("picture:", output)
+    fig.savefig(args.plot, dpi=80)
+    print("picture:", args.plot)
 
 
 if __name__ == "__main__":

@@ -99,6 +99,12 @@ def main() -> None:
                 f"t={clock['t']:5.1f} s  truth ({truth[0]:5.2f}, {truth[1]:5.2f})  "
                 f"error {error:.3f} m {yaw_error:.3f} rad  covariance trace {trace:.4f}"
             )
+    pose = nav_state.get("robot_pose", Odometry).pose
+    print(
+        f"final error {math.hypot(pose.x - truth[0], pose.y - truth[1]):.3f} m, "
+        f"{abs(math.remainder(pose.yaw - truth[2], 2 * math.pi)):.3f} rad after "
+        f"{clock['t']:.1f} s (the belief started 0.39 m and 0.25 rad off)"
+    )
 
 
 if __name__ == "__main__":

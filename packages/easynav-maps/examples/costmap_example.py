@@ -1,34 +1,33 @@
 """The costmap stack without ROS: a map-server map, live obstacles, inflation, a keepout zone,
 a speed zone and routes, through the same plugins a params file configures.
 
-    python packages/easynav-maps/examples/costmap_example.py [path/to/map.yaml] [output.png]
+    python packages/easynav-maps/examples/costmap_example.py [--map map.yaml] [--plot out.png]
 
-Without a map argument it makes a small walled room. Writes a picture of ``map.base`` and of
-``map`` after the filters, and prints the speed limit at the robot's position.
+Without ``--map`` it makes a small walled room. A laser sees a box the map does not have; the
+ObstaclesFilter marks it, the KeepoutFilter closes a zone, the InflationFilter inflates both
+and the SpeedFilter reads a slow zone. Prints the cells of each cost class in ``map.base`` and
+in ``map`` after the filters, the cost where the box is, and the speed limit at the robot's
+position; ``--plot`` (with matplotlib) draws ``map.base`` beside ``map``.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
-import sys
 import tempfile
 from pathlib import Path
 
 import cv2
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from easynav.core.nav_state import NavState  # noqa: E402
-from easynav.core.plugins import DictParameters, PluginContext  # noqa: E402
-from easynav.core.sensors import PointPerception  # noqa: E402
-from easynav.core.tf import get_tf_buffer  # noqa: E402
-from easynav.core.types import Header, Odometry, Pose, Transform, TransformStamped  # noqa: E402
-from easynav.maps.costmap import MAP, MAP_BASE, SPEED_LIMIT  # noqa: E402
-from easynav.maps.costmap.costmap_maps_manager import CostmapMapsManager  # noqa: E402
-from easynav.maps.routes.routes_maps_manager import RoutesMapsManager  # noqa: E402
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import DictParameters, PluginContext
+from easynav.core.sensors import PointPerception
+from easynav.core.tf import get_tf_buffer
+from easynav.core.types import Costmap2D, Header, Odometry, Pose, Transform, TransformStamped
+from easynav.maps.costmap import MAP, MAP_BASE, SPEED_LIMIT
+from easynav.maps.costmap.costmap_maps_manager import CostmapMapsManager
+from easynav.maps.routes.routes_maps_manager import RoutesMapsManager
 
 FILTER = "easynav_costmap_maps_manager/CostmapMapsManager/"
 
@@ -43,14 +42,29 @@ def write_map(folder: Path, name: str, pixels: np.ndarray, mode: str = "trinary"
     return folder / f"{name}.yaml"
 
 
+def cost_classes(costmap: Costmap2D) -> str:
+    data = costmap.data
+    return (f"{np.count_nonzero(data == 254)} lethal, {np.count_nonzero(data == 253)} inscribed, "
+            f"{np.count_nonzero((data > 0) & (data < 253))} graded, "
+            f"{np.count_nonzero(data == 0)} free, {np.count_nonzero(data == 255)} unknown")
+
+
 def main() -> None:
-    folder = Path(tempfile.mkdtemp(prefix="costmap_example_"))
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--map", help="a map_server YAML (default: a room made here)")
+    parser.add_argument("--plot", metavar="PNG", help="draw map.base and map (matplotlib)")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="costmap_example_") as tmp:
+        run(Path(tmp), args.map, args.plot)
+
+
+def run(folder: Path, map_file: str | None, plot: str | None) -> None:
+    """Write the masks and routes into ``folder``, run the plugins, print (and draw)."""
     room = np.full((120, 160), 254, np.uint8)  # 8 m x 6 m
     room[[0, -1], :] = 0
     room[:, [0, -1]] = 0
     room[30:90, 80] = 0  # a wall in the middle with passages above and below
-    given = sys.argv[1] if len(sys.argv) > 1 else ""
-    map_yaml = Path(given) if given else write_map(folder, "room", room)
+    map_yaml = Path(map_file) if map_file else write_map(folder, "room", room)
     keepout = np.full_like(room, 254)
     keepout[10:30, 100:140] = 0  # a keepout rectangle near the top right
     speed = np.full_like(room, 254)
@@ -94,17 +108,32 @@ def main() -> None:
     costmap.update(nav_state)  # the order of maps_manager_node.map_types: costmap, then routes
     routes.update(nav_state)
     limit = nav_state.get(SPEED_LIMIT)
+    print(f"map.base (the map): {cost_classes(nav_state.get(MAP_BASE))}")
+    print(f"map (after the filters): {cost_classes(nav_state.get(MAP))}")
+    grid = nav_state.get(MAP)
+    ix, iy = grid.world_to_cell(3.05, 4.5)
+    print(f"cost where the laser saw the box (3.05, 4.5): {grid.data[int(iy), int(ix)]} "
+          f"(254: lethal)")
     print(f"speed limit at (1, 1): {limit:.2f} of robot_limits ({math.floor(limit * 100)} %)")
 
-    output = Path(sys.argv[2]) if len(sys.argv) > 2 else folder / "costmap_example.png"
+    if not plot:
+        return
+    try:
+        import matplotlib
+    except ImportError:
+        print("--plot: matplotlib is not installed")
+        return
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     fig, axes = plt.subplots(1, 2, figsize=(12, 5))
     for ax, key, title in ((axes[0], MAP_BASE, "map.base"), (axes[1], MAP, "map (filtered)")):
         grid = nav_state.get(key)
         x0, y0, x1, y1 = grid.extent()
         ax.imshow(grid.data, origin="lower", extent=(x0, x1, y0, y1), cmap="viridis", vmax=255)
         ax.set_title(title)
-    fig.savefig(output, dpi=80)
-    print(f"wrote {output}")
+    fig.savefig(plot, dpi=80)
+    print(f"picture: {plot}")
 
 
 if __name__ == "__main__":

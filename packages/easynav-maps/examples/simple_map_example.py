@@ -1,24 +1,21 @@
 """SimpleMap in a few lines: load, query, downsample, convert, save, and draw.
 
-    python packages/easynav-maps/examples/simple_map_example.py [output.png]
+    python packages/easynav-maps/examples/simple_map_example.py [--plot output.png]
 
-Loads the house shipped with easynav-maps (and a Nav2 map when /work/shared/maps is there),
-marks a few "live" obstacles, downsamples to the planner's 0.2 m and writes a picture.
+Loads the house shipped with easynav-maps, marks a few "live" obstacles, downsamples to the
+planner's 0.2 m, converts and saves; ``--plot`` (with matplotlib) draws them (and a Nav2 map
+when /work/shared/maps is there).
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 import tempfile
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from easynav.maps import SimpleMap, resolve_map_file  # noqa: E402
+from easynav.maps import SimpleMap, resolve_map_file
 
 
 def draw(ax, world: SimpleMap, title: str) -> None:
@@ -30,7 +27,9 @@ def draw(ax, world: SimpleMap, title: str) -> None:
 
 
 def main() -> None:
-    output = Path(sys.argv[1]) if len(sys.argv) > 1 else Path("simple_map_example.png")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--plot", metavar="PNG", help="draw the maps (matplotlib)")
+    args = parser.parse_args()
     home = SimpleMap.load(resolve_map_file("easynav_maps", "worlds/home.map"))
     print("loaded", home)
     print("is (0, 0) free?", not home.occupied_at(0.0, 0.0))
@@ -50,6 +49,16 @@ def main() -> None:
         assert SimpleMap.load(Path(tmp) / "coarse.map") == coarse
         print("saved and reloaded", Path(tmp) / "coarse.map")
 
+    if not args.plot:
+        return
+    try:
+        import matplotlib
+    except ImportError:
+        print("--plot: matplotlib is not installed")
+        return
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     panels = [(live, "home.map + live obstacles"), (coarse, "downsampled to 0.2 m")]
     nav2 = Path("/work/shared/maps/tb3_sandbox.yaml")
     if nav2.is_file():
@@ -58,8 +67,8 @@ def main() -> None:
     for ax, (world, title) in zip(axes, panels, strict=True):
         draw(ax, world, title)
     fig.tight_layout()
-    fig.savefig(output, dpi=80)
-    print("picture:", output)
+    fig.savefig(args.plot, dpi=80)
+    print("picture:", args.plot)
 
 
 if __name__ == "__main__":
