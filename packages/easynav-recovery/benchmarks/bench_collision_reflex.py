@@ -20,7 +20,7 @@ import numpy as np
 
 from easynav.core.benchmarking import BenchRow, add_json_option, report
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import DictParameters, PluginContext
+from easynav.core.plugins import DictParameters, PluginContext, PluginServices
 from easynav.core.sensors import PointPerception
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Transform, TransformStamped, Twist
@@ -74,7 +74,7 @@ def main() -> None:
     context = PluginContext(
         parameters=DictParameters({}),
         namespace="bench_collision_reflex",
-        services={"recovery_actions": _NullActions()},
+        services=PluginServices(recovery_actions=_NullActions()),
     )
     get_tf_buffer(context.namespace).set_transform(
         TransformStamped(

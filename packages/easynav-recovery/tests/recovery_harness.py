@@ -1,7 +1,7 @@
 """Test helpers: recorded system actions, a simulated clock, a tiny robot and NavState builders.
 
 Everything here runs without ROS: plugins get ``PluginContext(parameters=DictParameters(...),
-node=None)`` and a :class:`RecordingActions` in ``services["recovery_actions"]``.
+node=None)`` and a :class:`RecordingActions` as ``PluginServices(recovery_actions=...)``.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import DictParameters, PluginContext, RecoveryActions
+from easynav.core.plugins import DictParameters, PluginContext, PluginServices, RecoveryActions
 from easynav.core.robot import RobotGeometry, RobotLimits
 from easynav.core.sensors import PointPerception
 from easynav.core.types import (
@@ -120,7 +120,7 @@ def make_context(
         namespace=namespace if namespace is not None else f"recovery_test_{next(_namespaces)}",
         now=clock or Clock(),
         robot_geometry=lambda: geometry,
-        services={"recovery_actions": actions} if actions is not None else {},
+        services=PluginServices(recovery_actions=actions),
     )
 
 

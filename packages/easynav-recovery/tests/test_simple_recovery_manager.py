@@ -17,7 +17,7 @@ from recovery_harness import (
     set_pose,
 )
 
-from easynav.core.plugins import PluginConfigurationError
+from easynav.core.plugins import PluginConfigurationError, PluginServices
 from easynav.core.robot import RobotGeometry
 from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
@@ -377,7 +377,7 @@ def test_the_brake_overrides_but_never_during_its_own_backup():
 def test_context_without_ros_is_enough():
     context = make_context()
     manager = SimpleRecoveryManager()
-    context.services["recovery_actions"] = None
+    context.services = PluginServices(recovery_actions=None)
     manager.initialize(context, "recovery_manager")
     assert manager.stop_distance == 0.3 and manager.max_backup_attempts == 3
 

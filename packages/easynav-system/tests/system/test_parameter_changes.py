@@ -86,7 +86,7 @@ def test_a_reconfiguration_is_checked_by_the_same_rules(active):
     assert not actions.request_reconfigure(
         [("controller_node", "dummy.cycle_time_rt", float("nan"))], "bad"
     )
-    check = active.system_node.system.services["check_reconfigure"]
+    check = active.system_node.system.services.check_reconfigure
     ok, why = check([("controller_node", "robot_limits.max_linear_vel", -1.0)])
     assert not ok and why == "controller_node.robot_limits.max_linear_vel = -1.0: must be >= 0"
     # Read at configure only, yet changeable through a reconfiguration (plugins reloaded).

@@ -389,8 +389,7 @@ class ControllerNode(ComponentNode):
         self.last_publish_monotonic = time.monotonic()
 
     def robot_frame(self) -> str:
-        tf_info = self.system.services.get("tf_info")
-        return tf_info().robot_frame if tf_info else "base_link"
+        return self.system.services.tf_info().robot_frame
 
     # -- braking ----------------------------------------------------------------------------------
     def brake(self) -> None:

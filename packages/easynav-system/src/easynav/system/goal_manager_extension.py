@@ -28,7 +28,7 @@ class GoalManagerExtension:
                 self.node.nav_state, params, self.node.now_seconds, self.node.get_logger()
             )
             self.ros = GoalManagerRos(self.node, self.goal_manager)
-            self.node.system.services["goal_manager"] = self.goal_manager
+            self.node.system.services.goal_manager = self.goal_manager
         else:
             self.goal_manager.set_params(params)
 

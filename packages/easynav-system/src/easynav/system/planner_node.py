@@ -40,7 +40,7 @@ class PlannerNode(ComponentNode):
             rejection = lp.plugin.take_goal_rejection()
             if rejection and goals is not None and len(goals) > 0:
                 self.get_logger().warning(f"goal rejected by {lp.alias}: {rejection}")
-                self.system.services["requests"].post_abort(rejection)
+                self.system.services.requests.post_abort(rejection)
             self._check_path(self.now_seconds())
 
     def _check_path(self, now: float) -> None:

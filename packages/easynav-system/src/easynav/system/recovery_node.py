@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 from easynav.core.nav_state_keys import PROPOSAL_OVERRIDE, PROPOSAL_TAKEOVER
 from easynav.core.plugins import RecoveryActions
 from easynav.core.plugins.plugin_kinds import RECOVERY_MANAGER
 from easynav.core.types import Twist
 from easynav.system.component_node import ComponentNode
-from easynav.system.system_requests import ReconfigureRequest, SystemRequests
+from easynav.system.system_requests import ParameterChange, ReconfigureRequest, SystemRequests
 
 DEFAULT_RECOVERY_MANAGER = "easynav_recovery/DummyRecoveryManager"
 
@@ -26,7 +24,7 @@ class NodeRecoveryActions(RecoveryActions):
 
     @property
     def _requests(self) -> SystemRequests:
-        return self._node.system.services["requests"]
+        return self._node.system.services.requests
 
     def command_velocity(self, twist: Twist) -> None:
         self._node.nav_state.set(PROPOSAL_TAKEOVER, twist)
@@ -44,8 +42,8 @@ class NodeRecoveryActions(RecoveryActions):
         self._node.get_logger().error(f"recovery system requests a shutdown: {reason}")
         self._requests.post_shutdown(reason, 1)
 
-    def request_reconfigure(self, changes: list[tuple[str, str, Any]], reason: str) -> bool:
-        check = self._node.system.services.get("check_reconfigure")
+    def request_reconfigure(self, changes: list[ParameterChange], reason: str) -> bool:
+        check = self._node.system.services.check_reconfigure
         if check is None:
             return False
         ok, why = check(changes)
@@ -56,7 +54,7 @@ class NodeRecoveryActions(RecoveryActions):
         return True
 
     def request_restore_parameters(self, reason: str) -> bool:
-        check = self._node.system.services.get("check_reconfigure")
+        check = self._node.system.services.check_reconfigure
         if check is None:
             return False
         ok, why = check([])
@@ -84,7 +82,7 @@ class RecoveryNode(ComponentNode):
     def __init__(self, namespace, system, **kwargs):
         super().__init__("recovery_node", namespace, system, **kwargs)
         self.actions = NodeRecoveryActions(self)
-        system.services["recovery_actions"] = self.actions
+        system.services.recovery_actions = self.actions
 
     def release_plugins(self) -> None:
         for lp in self.plugins:
@@ -94,9 +92,7 @@ class RecoveryNode(ComponentNode):
                 self.get_logger().warning(f"{lp.alias}: on_unload failed: {exc}")
         if self.plugins:
             # Holds are released when the manager is unloaded.
-            requests = self.system.services.get("requests")
-            if requests is not None:
-                requests.hold_progress = False
+            self.system.services.requests.hold_progress = False
         super().release_plugins()
 
     def cycle_rt(self) -> bool:

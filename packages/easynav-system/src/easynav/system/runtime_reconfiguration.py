@@ -33,7 +33,7 @@ class RuntimeReconfiguration:
         self.node = system_node
         self.originals: dict[tuple[str, str], Any] = {}
         self.allowed = lambda: (True, "")  # replaced by the safety supervisor (frozen config)
-        system_node.system.services["check_reconfigure"] = self.check
+        system_node.system.services.check_reconfigure = self.check
 
     def _target(self, node_name: str):
         if node_name == "system_node":

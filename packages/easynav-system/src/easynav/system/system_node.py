@@ -28,7 +28,7 @@ from easynav.system.runtime_reconfiguration import RuntimeReconfiguration
 from easynav.system.safety_supervisor import SafetySupervisor
 from easynav.system.sensors_node import SensorsNode
 from easynav.system.shared_clock import SharedClockSubscription
-from easynav.system.system_context import SystemContext
+from easynav.system.system_context import SystemContext, SystemServices
 from easynav.system.system_requests import SystemRequests
 from easynav.system.tf import TFListener
 
@@ -67,11 +67,15 @@ class SystemNode(LifecycleNode):
     def __init__(self, nav_state, namespace: str = "", **kwargs: Any) -> None:
         super().__init__("system_node", namespace=namespace, **kwargs)
         self.params = NodeParameters(self)
-        self.system = SystemContext(nav_state=nav_state, namespace=self.get_namespace())
-        self.nav_state = nav_state
         self.requests = SystemRequests()
-        self.system.services["requests"] = self.requests
-        self.system.services["tf_info"] = lambda: get_tf_buffer(self._ns_key()).get_tf_info()
+        services = SystemServices(
+            requests=self.requests,
+            tf_info=lambda: get_tf_buffer(self._ns_key()).get_tf_info(),
+        )
+        self.system = SystemContext(
+            nav_state=nav_state, services=services, namespace=self.get_namespace()
+        )
+        self.nav_state = nav_state
         self.system.robot_geometry = lambda: RobotGeometryRegistry.get(self._ns_key())
         self.error_message = ""
         self.active = False

@@ -6,12 +6,15 @@ import threading
 from dataclasses import dataclass, field
 from typing import Any
 
+#: One parameter change: ``(node name, parameter name, value)``.
+ParameterChange = tuple[str, str, Any]
+
 
 @dataclass
 class ReconfigureRequest:
     """Parameter changes ``(node, parameter, value)`` to apply through a reconfiguration."""
 
-    changes: list[tuple[str, str, Any]]
+    changes: list[ParameterChange]
     reason: str
     restore: bool = False
 

@@ -6,9 +6,12 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from easynav.core.robot import RobotGeometry, RobotLimits
+
+if TYPE_CHECKING:
+    from easynav.core.plugins.recovery_manager_base import RecoveryActions
 
 
 class ParameterAccess:
@@ -51,6 +54,33 @@ class DictParameters(ParameterAccess):
         return name in self.values
 
 
+class ServiceUnavailableError(LookupError):
+    """A plugin asked its host for a service the host does not offer (e.g. the recovery
+    actions of a plugin run without the EasyNav runtime)."""
+
+
+@dataclass(frozen=True)
+class PluginServices:
+    """The services a host offers its plugins, beyond parameters, clocks and the robot.
+
+    ``recovery_actions``: the system actions of the recovery system (recovery_node implements
+    them; see :class:`~easynav.core.plugins.RecoveryActions`), None when the host offers none.
+    Plugins read them through :meth:`require_recovery_actions` (or their base class's
+    ``actions`` property), which names what is missing.
+    """
+
+    recovery_actions: RecoveryActions | None = None
+
+    def require_recovery_actions(self) -> RecoveryActions:
+        """The recovery actions; :class:`ServiceUnavailableError` when the host offers none."""
+        if self.recovery_actions is None:
+            raise ServiceUnavailableError(
+                "no recovery actions: the host offers none (recovery_node offers them; a plugin "
+                "run without the EasyNav runtime needs PluginServices(recovery_actions=...))"
+            )
+        return self.recovery_actions
+
+
 def _monotonic_seconds() -> float:
     return time.monotonic()
 
@@ -68,6 +98,7 @@ class PluginContext:
     cannot delay them; their callbacks run in the RT thread and must only store the data.
     ``frequencies_in_use`` collects ``(node_name, "<plugin_name>.rt_freq|freq")`` of the
     frequencies the loaded plugins actually use (the configuration checks look only at those).
+    ``services`` are the host's services (see :class:`PluginServices`): none without a host.
     """
 
     parameters: ParameterAccess = field(default_factory=DictParameters)
@@ -80,7 +111,6 @@ class PluginContext:
     logger: Any = field(default_factory=lambda: logging.getLogger("easynav"))
     robot_geometry: Callable[[], RobotGeometry] = RobotGeometry
     robot_limits: Callable[[], RobotLimits] = RobotLimits
-    # Recovery system actions and other host services, set by the hosts that offer them.
-    services: dict[str, Any] = field(default_factory=dict)
+    services: PluginServices = field(default_factory=PluginServices)
     rt_node: Any = None
     frequencies_in_use: set[tuple[str, str]] | None = None

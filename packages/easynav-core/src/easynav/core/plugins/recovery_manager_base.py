@@ -56,8 +56,9 @@ class RecoveryManagerBase(MethodBase):
 
     @property
     def actions(self) -> RecoveryActions:
-        """The system actions (see :class:`RecoveryActions`)."""
-        return self.context.services["recovery_actions"]
+        """The system actions (see :class:`RecoveryActions`); :class:`ServiceUnavailableError`
+        when the host offers none."""
+        return self.context.services.require_recovery_actions()
 
     def update(self, nav_state: NavState) -> None:
         """Diagnose and decide. Non-RT thread."""

@@ -56,8 +56,9 @@ class MitigationBase(MethodBase):
 
     @property
     def actions(self) -> RecoveryActions:
-        """The recovery node's system actions."""
-        return self.context.services["recovery_actions"]
+        """The recovery node's system actions; ``ServiceUnavailableError`` when the host offers
+        none."""
+        return self.context.services.require_recovery_actions()
 
     def attach(self, slot: TakeoverSlot, report_sink: Callable[[int, str], None]) -> None:
         """Called by the manager after ``initialize``: where velocities and reports go."""

@@ -44,8 +44,9 @@ class SafetyReflexBase(MethodBase):
 
     @property
     def actions(self) -> RecoveryActions:
-        """The recovery node's system actions."""
-        return self.context.services["recovery_actions"]
+        """The recovery node's system actions; ``ServiceUnavailableError`` when the host offers
+        none."""
+        return self.context.services.require_recovery_actions()
 
     @property
     def diagnostic_name(self) -> str:
