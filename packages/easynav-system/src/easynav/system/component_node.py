@@ -5,7 +5,8 @@ from __future__ import annotations
 import math
 import time
 import traceback
-from typing import Any
+from collections.abc import Callable
+from typing import Any, Literal
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
@@ -25,6 +26,9 @@ from easynav.core.types import DiagnosticLevel, DiagnosticStatus
 from easynav.system.cycle_times import CycleTimes
 from easynav.system.node_parameters import NodeParameters
 from easynav.system.system_context import SystemContext
+
+#: The two cycle methods of a plugin (the kind's base class defines those it has).
+PluginUpdate = Literal["update_rt", "update"]
 
 
 class ConfigurationError(RuntimeError):
@@ -121,25 +125,28 @@ class ComponentNode(LifecycleNode):
                     monitor.restart()
             lp.plugin.rt_schedule.reset()
             lp.plugin.schedule.reset()
-            self._notify(lp, "on_activate")
+            self._notify(lp, lp.plugin.on_activate)
         self.active = True
         return super().on_activate(state)
 
     def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
         self.active = False
         for lp in self.plugins:
-            self._notify(lp, "on_deactivate")
+            self._notify(lp, lp.plugin.on_deactivate)
             for method, times in lp.times.items():
                 line = times.describe(lp.alias, lp.name, method)
                 if line is not None:
                     self.get_logger().info(line)
         return super().on_deactivate(state)
 
-    def _notify(self, lp: LoadedPlugin, hook: str) -> None:
+    def _notify(self, lp: LoadedPlugin, hook: Callable[[], None]) -> None:
+        """Call one of the plugin's lifecycle hooks (``lp.plugin.on_activate``...), containing
+        its exception."""
         try:
-            getattr(lp.plugin, hook)()
+            hook()
         except Exception as exc:  # a plugin's hook must not block the lifecycle
-            self.get_logger().error(f"{lp.alias}.{hook} raised {type(exc).__name__}: {exc}")
+            name = hook.__name__
+            self.get_logger().error(f"{lp.alias}.{name} raised {type(exc).__name__}: {exc}")
 
     def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
         self.active = False
@@ -354,7 +361,7 @@ class ComponentNode(LifecycleNode):
             # Simulated time that has not started (no /clock yet for this node): time-based
             # plugins would take the jump to the first clock message for seconds without data.
             return []
-        method = "update_rt" if rt else "update"
+        method: PluginUpdate = "update_rt" if rt else "update"
         ran = []
         for lp in self.plugins:
             plugin = lp.plugin
@@ -378,8 +385,9 @@ class ComponentNode(LifecycleNode):
         if status is not None:
             write_diagnostic(self.nav_state, monitor.name, status)
 
-    def run_plugin(self, lp: LoadedPlugin, method: str) -> tuple[bool, Any]:
-        """Call ``lp.plugin.<method>(nav_state)``; contain and report exceptions.
+    def run_plugin(self, lp: LoadedPlugin, method: PluginUpdate) -> tuple[bool, Any]:
+        """Call ``lp.plugin.update_rt(nav_state)`` or ``lp.plugin.update(nav_state)``
+        (``method``); contain and report exceptions.
 
         Returns ``(ok, result)``. An exception is logged at most once per second, reported as an
         ERROR ``diagnostics.<alias>.error`` while it repeats, and OK again once every method of
@@ -387,7 +395,9 @@ class ComponentNode(LifecycleNode):
         """
         try:
             start = time.perf_counter()
-            result = getattr(lp.plugin, method)(self.nav_state)
+            plugin = lp.plugin
+            update = plugin.update_rt if method == "update_rt" else plugin.update
+            result = update(self.nav_state)
             lp.times[method].record(time.perf_counter() - start)
         except Exception as exc:
             now = time.monotonic()

@@ -5,9 +5,10 @@ from __future__ import annotations
 from easynav.system.goals.goal_manager import GoalManager
 from easynav.system.goals.goal_manager_params import GoalManagerParams
 from easynav.system.goals.goal_manager_ros import GoalManagerRos
+from easynav.system.system_extension import SystemExtension
 
 
-class GoalManagerExtension:
+class GoalManagerExtension(SystemExtension):
     """Creates the goal manager at the first configure and keeps it: an ongoing mission
     survives a reconfiguration (cleanup → configure). Each configure applies the parameters
     again. Each non-RT cycle applies the recovery system's requests (abort, hold progress) and

@@ -8,10 +8,12 @@ from typing import Any
 
 from rclpy.parameter import Parameter
 
+from easynav.system.component_node import ComponentNode
+from easynav.system.system_extension import SystemExtension
 from easynav.system.system_requests import ReconfigureRequest
 
 
-class RuntimeReconfiguration:
+class RuntimeReconfiguration(SystemExtension):
     """Applies :class:`ReconfigureRequest` s posted by ``request_reconfigure`` /
     ``request_restore_parameters``.
 
@@ -51,10 +53,9 @@ class RuntimeReconfiguration:
             if not (target.has_parameter(name) or name in target._parameter_overrides):
                 return False, f"unknown parameter '{node_name}/{name}'"
             # The same rules as any change (the node's or the loaded plugin's declaration).
-            checker = getattr(target, "check_parameter_change", None)
-            if checker is not None:
+            if isinstance(target, ComponentNode):
                 try:
-                    checker(name, value, reconfiguring=True)
+                    target.check_parameter_change(name, value, reconfiguring=True)
                 except ValueError as exc:
                     return False, str(exc)
         return True, ""

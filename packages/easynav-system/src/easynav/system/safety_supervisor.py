@@ -36,6 +36,7 @@ from easynav.system.safety import (
     lock_memory,
     ros_log_dir,
 )
+from easynav.system.system_extension import SystemExtension
 
 #: Defaults by name (read-only view for tools and tests).
 SAFETY_DEFAULTS: dict[str, Any] = {param.name: param.default for param in SAFETY_PARAMETERS}
@@ -45,7 +46,7 @@ def _type_name(parameter: Parameter) -> str:
     return PARAMETER_TYPES[parameter.type_.value]
 
 
-class SafetySupervisor:
+class SafetySupervisor(SystemExtension):
     """The safety supervisor of system_node.
 
     On configure (after every sub-node configured): the configuration checks (any failure fails
@@ -87,6 +88,7 @@ class SafetySupervisor:
             ),
         )
         self._stop_requested = False
+        self.lock_memory = False  # safety.lock_memory, read at configure
         for node in system_node.all_nodes():
             node.add_on_set_parameters_callback(self._make_parameter_guard(node))
         system_node.reconfiguration.allowed = self.freeze.check_reconfiguration
@@ -242,7 +244,7 @@ class SafetySupervisor:
 
     # -- activation --------------------------------------------------------------------------------
     def before_activate(self) -> None:
-        if getattr(self, "lock_memory", False):
+        if self.lock_memory:
             ok, message = lock_memory()
             if not ok:
                 raise ConfigurationError(f"system_node/safety.lock_memory: {message}")

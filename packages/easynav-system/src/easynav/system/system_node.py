@@ -29,6 +29,7 @@ from easynav.system.safety_supervisor import SafetySupervisor
 from easynav.system.sensors_node import SensorsNode
 from easynav.system.shared_clock import SharedClockSubscription
 from easynav.system.system_context import SystemContext, SystemServices
+from easynav.system.system_extension import SystemExtension
 from easynav.system.system_requests import SystemRequests
 from easynav.system.tf import TFListener
 
@@ -97,7 +98,8 @@ class SystemNode(LifecycleNode):
             "recovery_node": self.recovery_node,
         }
         self.navstate_publisher = self.create_publisher(String, "easynav_navstate", 1)
-        self.extensions: list[Any] = []  # goal manager, safety supervisor: see add_extension
+        # Goal manager, runtime reconfiguration, safety supervisor: see add_extension.
+        self.extensions: list[SystemExtension] = []
         self.goal_manager = GoalManagerExtension(self)
         self.add_extension(self.goal_manager)
         self.reconfiguration = RuntimeReconfiguration(self)
@@ -134,18 +136,11 @@ class SystemNode(LifecycleNode):
         return self.get_clock().now().nanoseconds * 1e-9
 
     # -- extensions -----------------------------------------------------------------------------
-    def add_extension(self, extension: Any) -> None:
-        """Register an object with optional hooks ``configure()``, ``activate()``,
-        ``deactivate()``, ``cleanup()``, ``cycle_rt_start()``, ``cycle_rt_end()``, ``cycle()``,
-        called at the matching points (goal manager, safety supervisor).
+    def add_extension(self, extension: SystemExtension) -> None:
+        """Register an extension: its hooks (see :class:`SystemExtension`) are called at the
+        matching points, after those of the extensions registered before it.
         """
         self.extensions.append(extension)
-
-    def _call_extensions(self, hook: str) -> None:
-        for ext in self.extensions:
-            method = getattr(ext, hook, None)
-            if method is not None:
-                method()
 
     # -- configuration --------------------------------------------------------------------------
     def read_parameters(self) -> None:
@@ -217,7 +212,8 @@ class SystemNode(LifecycleNode):
 
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
         self.error_message = ""
-        self._call_extensions("before_configure")
+        for ext in self.extensions:
+            ext.before_configure()
         try:
             self.read_parameters()
         except Exception as exc:
@@ -238,7 +234,8 @@ class SystemNode(LifecycleNode):
         if errors:
             return self._fail_configure("incompatible plugins: " + "; ".join(errors), configured)
         try:
-            self._call_extensions("configure")
+            for ext in self.extensions:
+                ext.configure()
         except Exception as exc:
             return self._fail_configure(str(exc), configured)
         return TransitionCallbackReturn.SUCCESS
@@ -251,27 +248,31 @@ class SystemNode(LifecycleNode):
             if node.lifecycle_state() == "inactive":
                 node.trigger_cleanup()
         try:
-            self._call_extensions("cleanup")
+            for ext in self.extensions:
+                ext.cleanup()
         except Exception as exc:
             self.get_logger().warning(f"cleanup after a failed configure: {exc}")
         return TransitionCallbackReturn.FAILURE
 
     def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
         try:
-            self._call_extensions("before_activate")
+            for ext in self.extensions:
+                ext.before_activate()
         except Exception as exc:
             self.error_message = str(exc)
             self.get_logger().error(f"EasyNav failed to activate: {exc}")
             return TransitionCallbackReturn.FAILURE
         for name in SUBNODE_ORDER:
             self.subnodes[name].trigger_activate()
-        self._call_extensions("activate")
+        for ext in self.extensions:
+            ext.activate()
         self.active = True
         return super().on_activate(state)
 
     def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
         self._stop_cycles()
-        self._call_extensions("deactivate")
+        for ext in self.extensions:
+            ext.deactivate()
         for name in reversed(SUBNODE_ORDER):  # controller_node brakes to an exact zero
             node = self.subnodes[name]
             if node.lifecycle_state() == "active":
@@ -288,12 +289,14 @@ class SystemNode(LifecycleNode):
             node = self.subnodes[name]
             if node.lifecycle_state() == "inactive":
                 node.trigger_cleanup()
-        self._call_extensions("cleanup")
+        for ext in self.extensions:
+            ext.cleanup()
         return TransitionCallbackReturn.SUCCESS
 
     def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
         self._stop_cycles()
-        self._call_extensions("deactivate")
+        for ext in self.extensions:
+            ext.deactivate()
         for name in reversed(SUBNODE_ORDER):
             node = self.subnodes[name]
             if node.lifecycle_state() in ("unconfigured", "inactive", "active"):
@@ -313,22 +316,16 @@ class SystemNode(LifecycleNode):
             if not self.active:
                 return
             for ext in self.extensions:
-                hook = getattr(ext, "cycle_rt_start", None)
-                if hook is not None:
-                    hook()
+                ext.cycle_rt_start()
             new_data = self.sensors_node.cycle_rt() or triggered
             localizer_ran = self.localizer_node.cycle_rt(new_data)
             self.controller_node.cycle_rt(new_data or localizer_ran)
             self.recovery_node.cycle_rt()
             for ext in self.extensions:
-                hook = getattr(ext, "cycle_rt_before_publish", None)
-                if hook is not None:
-                    hook()
+                ext.cycle_rt_before_publish()
             self.controller_node.publish_cycle()
             for ext in self.extensions:
-                hook = getattr(ext, "cycle_rt_end", None)
-                if hook is not None:
-                    hook()
+                ext.cycle_rt_end()
 
     def rt_wake_pending(self) -> bool:
         """True when new sensor data waits: the RT loop runs a cycle at once. RT thread."""
@@ -343,12 +340,14 @@ class SystemNode(LifecycleNode):
                 self.sensors_node.cycle()
                 self.localizer_node.cycle()
                 self.maps_manager_node.cycle()
-                self._call_extensions("cycle")
+                for ext in self.extensions:
+                    ext.cycle()
                 self.planner_node.cycle()
                 self.recovery_node.cycle()
                 if self.navstate_publisher.get_subscription_count() > 0:
                     self.navstate_publisher.publish(String(data=self.nav_state.debug_string()))
-            self._call_extensions("between_cycles")
+            for ext in self.extensions:
+                ext.between_cycles()
 
     # -- introspection ------------------------------------------------------------------------
     def loaded_plugins(self) -> dict[str, list[tuple[str, str]]]:
