@@ -97,6 +97,20 @@ def test_rejected_messages_are_counted_and_never_raise(caplog):
     assert "failed" in caplog.text
 
 
+def test_a_plugin_handler_returning_ragged_points_is_rejected_not_raised(caplog):
+    laser, _ = channel()
+
+    class RaggedHandler:
+        def to_perception(self, msg, sensor_id):
+            return PointPerception(stamp=100.0, points=[[0.0, 1.0, 2.0], [3.0]])
+
+    laser.handler = RaggedHandler()
+    with caplog.at_level(logging.WARNING, logger="easynav.sensors"):
+        assert laser.convert(make_scan([1.0], stamp=100.0)) is None
+    assert laser.rejected == 1
+    assert "RaggedHandler returned points that are not an array of numbers" in caplog.text
+
+
 def test_end_new_data_and_expire_replace_the_perception_never_mutate_it():
     laser, clock = channel()
     nav_state = NavState()

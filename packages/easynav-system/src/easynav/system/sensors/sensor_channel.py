@@ -219,7 +219,16 @@ class SensorChannel:
     def _checked_points(self, perception: PointPerception) -> PointPerception | None:
         # The PointPerception contract (no NaN/inf rows, (N, 3) float64, read-only) is kept by
         # the built-in converters; a plugin handler's output is checked here.
-        points = np.asarray(perception.points, dtype=np.float64)
+        try:
+            points = np.asarray(perception.points, dtype=np.float64)
+        except (TypeError, ValueError) as exc:  # ragged or not numbers: the callback never raises
+            self._rejected += 1
+            self._warn(
+                "shape",
+                f"handler {type(self.handler).__name__} returned points that are not an array of "
+                f"numbers ({exc}): message rejected",
+            )
+            return None
         if points.ndim != 2 or points.shape[1] != 3:
             self._rejected += 1
             self._warn(
