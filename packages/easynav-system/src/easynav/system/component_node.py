@@ -25,6 +25,7 @@ from easynav.core.plugins.plugin_kinds import PluginKind
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus
 from easynav.system.cycle_times import CycleTimes
 from easynav.system.node_parameters import NodeParameters
+from easynav.system.ros.rclpy_private import lifecycle_state_label
 from easynav.system.system_context import SystemContext
 
 #: The two cycle methods of a plugin (the kind's base class defines those it has).
@@ -100,7 +101,7 @@ class ComponentNode(LifecycleNode):
 
     def lifecycle_state(self) -> str:
         """Label of the current lifecycle state (unconfigured, inactive, active, finalized)."""
-        return self._state_machine.current_state[1]
+        return lifecycle_state_label(self)
 
     # -- lifecycle ----------------------------------------------------------------------------
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:

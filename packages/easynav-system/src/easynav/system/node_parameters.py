@@ -13,6 +13,7 @@ from rclpy.exceptions import (
 from rclpy.parameter import Parameter
 
 from easynav.core.plugins.plugin_context import ParameterAccess
+from easynav.system.ros.rclpy_private import parameter_override
 
 
 class ParameterError(ValueError):
@@ -73,7 +74,7 @@ class NodeParameters(ParameterAccess):
             except ParameterUninitializedException:  # an empty list declared by type only
                 return [] if isinstance(default, list) else default
         descriptor = ParameterDescriptor(description=description)
-        override = node._parameter_overrides.get(name)  # rclpy keeps them here, by full name
+        override = parameter_override(node, name)
         try:
             if (
                 isinstance(default, list)
@@ -120,7 +121,7 @@ class NodeParameters(ParameterAccess):
             raise ParameterError(f"{self._node.get_name()}.{name}: {result.reason}")
 
     def is_set(self, name: str) -> bool:
-        return name in self._node._parameter_overrides or name in self.changed
+        return parameter_override(self._node, name) is not None or name in self.changed
 
     def get(self, name: str) -> Any:
         """The value of a declared parameter."""

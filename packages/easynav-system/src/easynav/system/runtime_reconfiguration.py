@@ -9,6 +9,7 @@ from typing import Any
 from rclpy.parameter import Parameter
 
 from easynav.system.component_node import ComponentNode
+from easynav.system.ros.rclpy_private import parameter_override, set_parameter_override
 from easynav.system.system_extension import SystemExtension
 from easynav.system.system_requests import ReconfigureRequest
 
@@ -50,7 +51,7 @@ class RuntimeReconfiguration(SystemExtension):
             target = self._target(node_name)
             if target is None:
                 return False, f"unknown node '{node_name}'"
-            if not (target.has_parameter(name) or name in target._parameter_overrides):
+            if not (target.has_parameter(name) or parameter_override(target, name) is not None):
                 return False, f"unknown parameter '{node_name}/{name}'"
             # The same rules as any change (the node's or the loaded plugin's declaration).
             if isinstance(target, ComponentNode):
@@ -98,7 +99,7 @@ class RuntimeReconfiguration(SystemExtension):
         target = self._target(node_name)
         if target.has_parameter(name):
             return target.get_parameter(name).value
-        override = target._parameter_overrides.get(name)
+        override = parameter_override(target, name)
         return None if override is None else override.value
 
     def _reconfigure(self, changes: list[tuple[str, str, Any]]) -> bool:
@@ -132,7 +133,7 @@ class RuntimeReconfiguration(SystemExtension):
             if not result.successful:
                 raise ValueError(f"{target.get_name()}/{name}: {result.reason}")
         else:
-            target._parameter_overrides[name] = Parameter(name, value=value)
+            set_parameter_override(target, name, value)
 
     def _publish_list(self) -> None:
         names = sorted(f"{n}/{p}" for n, p in self.originals)

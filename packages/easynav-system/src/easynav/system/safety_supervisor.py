@@ -7,6 +7,7 @@ import time
 from typing import Any
 
 from rcl_interfaces.msg import SetParametersResult
+from rcl_interfaces.srv import ListParameters
 from rclpy.duration import Duration
 from rclpy.parameter import Parameter
 from rclpy.qos import (
@@ -154,9 +155,10 @@ class SafetySupervisor(SystemExtension):
         """Every parameter of every EasyNav node: ``{node: {name: (type, value)}}``."""
         result = {}
         for n in self.node.all_nodes():
-            result[n.get_name()] = {
-                name: (_type_name(param), param.value) for name, param in n._parameters.items()
-            }
+            names = n.list_parameters([], ListParameters.Request.DEPTH_RECURSIVE).names
+            # get_parameter_or: a parameter declared by type only, without a value, is NOT_SET.
+            params = (n.get_parameter_or(name) for name in names)
+            result[n.get_name()] = {p.name: (_type_name(p), p.value) for p in params}
         return result
 
     def _controller_rt_freq(self) -> float | None:

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import rosgraph_msgs.msg
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from rclpy.time_source import CLOCK_TOPIC
+from rclpy.time_source import CLOCK_TOPIC, TimeSource
+
+from easynav.system.ros.rclpy_private import take_over_clock_subscription
 
 
 class SharedClockSubscription:
@@ -32,15 +32,11 @@ class SharedClockSubscription:
 
     def __init__(self, host: Node, nodes: list[Node]) -> None:
         self._host = host
-        self._sources: list[Any] = []
+        self._sources: list[TimeSource] = []
         self.subscription = None
         for node in nodes:
-            source = node._time_source  # rclpy keeps it private; one per node
-            if source._clock_sub is not None:
-                node.destroy_subscription(source._clock_sub)
-                source._clock_sub = None
             # A later use_sim_time=true subscribes the shared subscription, not the node's own.
-            source._subscribe_to_clock_topic = self._subscribe
+            source = take_over_clock_subscription(node, self._subscribe)
             self._sources.append(source)
             if source.ros_time_is_active:
                 self._subscribe()

@@ -24,6 +24,7 @@ from easynav.system.node_declarations import SYSTEM_PARAMETERS, SYSTEM_PARAMETER
 from easynav.system.node_parameters import NodeParameters
 from easynav.system.planner_node import PlannerNode
 from easynav.system.recovery_node import RecoveryNode
+from easynav.system.ros.rclpy_private import lifecycle_state_label, parameter_override
 from easynav.system.runtime_reconfiguration import RuntimeReconfiguration
 from easynav.system.safety_supervisor import SafetySupervisor
 from easynav.system.sensors_node import SensorsNode
@@ -129,7 +130,7 @@ class SystemNode(LifecycleNode):
         return [self, *self.subnodes.values()]
 
     def lifecycle_state(self) -> str:
-        return self._state_machine.current_state[1]
+        return lifecycle_state_label(self)
 
     def now_seconds(self) -> float:
         """system_node's clock in seconds (simulated time with use_sim_time)."""
@@ -162,8 +163,10 @@ class SystemNode(LifecycleNode):
         self.system.system_rt_freq = float(p["rt_freq"])
         self.system.system_freq = float(p["freq"])
         # The deprecated system_node.use_cmd_vel_stamped is forwarded to controller_node.
-        overrides = self._parameter_overrides
-        if "use_cmd_vel_stamped" in overrides or self.has_parameter("use_cmd_vel_stamped"):
+        if (
+            parameter_override(self, "use_cmd_vel_stamped") is not None
+            or self.has_parameter("use_cmd_vel_stamped")
+        ):
             value = bool(self.params.declare("use_cmd_vel_stamped", False))
             self.get_logger().warning(
                 "system_node.use_cmd_vel_stamped is deprecated: use "
@@ -198,7 +201,7 @@ class SystemNode(LifecycleNode):
         owners: dict[str, list[str]] = {}
         for node_name, parameter in TYPES_PARAMETERS.items():
             node = self.subnodes[node_name]
-            override = node._parameter_overrides.get(parameter)
+            override = parameter_override(node, parameter)
             aliases = list(override.value) if override is not None and override.value else []
             if node.has_parameter(parameter):
                 aliases = list(node.get_parameter(parameter).value or [])
