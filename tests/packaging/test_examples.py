@@ -35,6 +35,10 @@ EXPECTED: dict[str, list[str]] = {
         r"^MPPIController +arrived after .* final distance 0\.\d+ m",
     ],
     "easynav-controllers/follow_path.py": [r"^arrived after [\d.]+ s: 0\.\d+ m from the end"],
+    "easynav-faulty/inject_faults.py": [
+        r"^update 1: robot_pose \(1\.00, 2\.00\) +path of 21 poses, finite +cmd_vel vx 0\.2 ",
+        r"^update 5: robot_pose \(2\.00, 2\.00\) +path of \d+ poses, NOT FINITE +cmd_vel vx 1000 ",
+    ],
     "easynav-localizers/amcl_on_house.py": [r"^final error 0\.[01]\d+ m, "],
     "easynav-maps/costmap_example.py": [
         r"^map \(after the filters\): \d+ lethal, \d+ inscribed",
