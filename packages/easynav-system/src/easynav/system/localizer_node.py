@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from easynav.core.nav_state_keys import ROBOT_POSE
 from easynav.core.plugins.localizer_method_base import INITIAL_POSE_TOPIC
 from easynav.core.plugins.plugin_kinds import LOCALIZER
 from easynav.core.types import Odometry
@@ -40,9 +41,9 @@ class LocalizerNode(ComponentNode):
             self._initial_pose_subscription = self.create_subscription(
                 PoseWithCovarianceStamped, INITIAL_POSE_TOPIC, self._on_initial_pose, 10
             )
-        if not self.nav_state.has("robot_pose"):
+        if not self.nav_state.has(ROBOT_POSE):
             return
-        pose = self.nav_state.get_safe("robot_pose", Odometry)
+        pose = self.nav_state.get_safe(ROBOT_POSE, Odometry)
         if pose.is_finite():
             for lp in self.plugins:
                 lp.plugin.on_last_known_pose(pose)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from easynav.core.diagnostics import write_diagnostic
+from easynav.core.nav_state_keys import GOALS, PATH
 from easynav.core.plugins.plugin_kinds import PLANNER
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Header, Path
 from easynav.system.component_node import ComponentNode
@@ -33,7 +34,7 @@ class PlannerNode(ComponentNode):
         """Plan when due or forced by new goals. Non-RT thread."""
         if not self.active:
             return
-        goals = self.nav_state.get("goals") if self.nav_state.has("goals") else None
+        goals = self.nav_state.get(GOALS) if self.nav_state.has(GOALS) else None
         force = goals is not self._planned_goals
         self._planned_goals = goals
         for lp, _ok in self.run_scheduled(rt=False, force=force):
@@ -44,9 +45,9 @@ class PlannerNode(ComponentNode):
             self._check_path(self.now_seconds())
 
     def _check_path(self, now: float) -> None:
-        if not self.nav_state.has("path"):
+        if not self.nav_state.has(PATH):
             return
-        path = self.nav_state.get("path", Path)
+        path = self.nav_state.get(PATH, Path)
         if path.is_finite():
             if self._path_rejected:
                 self._path_rejected = False
@@ -56,7 +57,7 @@ class PlannerNode(ComponentNode):
                     DiagnosticStatus(DiagnosticLevel.OK, "path", "finite path", "planner"),
                 )
             return
-        self.nav_state.set("path", Path(Header(now, path.header.frame_id), []))
+        self.nav_state.set(PATH, Path(Header(now, path.header.frame_id), []))
         if not self._path_rejected:
             self._path_rejected = True
             self.get_logger().error("the planner produced a path with a non-finite pose: discarded")

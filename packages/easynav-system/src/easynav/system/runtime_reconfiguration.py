@@ -8,6 +8,7 @@ from typing import Any
 
 from rclpy.parameter import Parameter
 
+from easynav.core.nav_state_keys import RECONFIGURED_PARAMETERS
 from easynav.system.component_node import ComponentNode
 from easynav.system.ros.rclpy_private import parameter_override, set_parameter_override
 from easynav.system.system_extension import SystemExtension
@@ -137,4 +138,4 @@ class RuntimeReconfiguration(SystemExtension):
 
     def _publish_list(self) -> None:
         names = sorted(f"{n}/{p}" for n, p in self.originals)
-        self.node.nav_state.set("reconfigured_parameters", names)
+        self.node.nav_state.set(RECONFIGURED_PARAMETERS, names)

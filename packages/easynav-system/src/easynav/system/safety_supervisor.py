@@ -20,6 +20,12 @@ from rclpy.qos import (
 from std_msgs.msg import String
 
 from easynav.core.diagnostics import write_diagnostic
+from easynav.core.nav_state_keys import (
+    CONFIGURATION_HASH,
+    MOTION_INHIBITED,
+    ROBOT_POSE,
+    SAFETY_STATUS,
+)
 from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.types import Odometry
 from easynav.system.component_node import ConfigurationError
@@ -178,7 +184,7 @@ class SafetySupervisor(SystemExtension):
             logger.warning(warning)
         logger.info("\n".join(fingerprint.log_lines(self.node.loaded_plugins())))
         self.configuration_publisher.publish(String(data=fingerprint.topic_text()))
-        self.nav_state.set("configuration_hash", fingerprint.hash)
+        self.nav_state.set(CONFIGURATION_HASH, fingerprint.hash)
         self.fingerprint = fingerprint
         if self.heartbeat is not None:
             self.heartbeat.set_configuration_hash(fingerprint.hash)
@@ -210,8 +216,8 @@ class SafetySupervisor(SystemExtension):
             self.rt_io_node.destroy_subscription(self.status_subscription)
             self.status_subscription = None
         self.channel = None
-        if self.nav_state.has("safety_status"):
-            self.nav_state.erase("safety_status")
+        if self.nav_state.has(SAFETY_STATUS):
+            self.nav_state.erase(SAFETY_STATUS)
         if timeout > 0.0:
             from easynav_interfaces.msg import SafetyStatus
 
@@ -223,7 +229,7 @@ class SafetySupervisor(SystemExtension):
                 QoSProfile(depth=10, reliability=QoSReliabilityPolicy.RELIABLE),
             )
             # No valid status yet: the robot does not move until the first one arrives.
-            self.nav_state.set("safety_status", self.channel.state(time.monotonic()))
+            self.nav_state.set(SAFETY_STATUS, self.channel.state(time.monotonic()))
 
     def _on_status(self, msg) -> None:
         channel = self.channel
@@ -281,18 +287,18 @@ class SafetySupervisor(SystemExtension):
         mono = time.monotonic()
         channel = self.channel
         if channel is not None:
-            nav_state.set("safety_status", channel.state(mono))
+            nav_state.set(SAFETY_STATUS, channel.state(mono))
             change = channel.diagnostic_change(mono)
             if change is not None:
                 write_diagnostic(nav_state, "safety_status", change)
         check = self.pose_check
         if check is not None and check.enabled:
-            pose = nav_state.get("robot_pose", Odometry) if nav_state.has("robot_pose") else None
+            pose = nav_state.get(ROBOT_POSE, Odometry) if nav_state.has(ROBOT_POSE) else None
             usable, change = check.check(pose, self.node.now_seconds())
             if change is not None:
                 write_diagnostic(nav_state, "robot_pose", change)
             if self.mode:
-                nav_state.set("motion_inhibited", not usable)
+                nav_state.set(MOTION_INHIBITED, not usable)
 
     def cycle_rt_end(self) -> None:
         heartbeat = self.heartbeat

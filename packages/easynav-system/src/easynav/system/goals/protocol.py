@@ -7,6 +7,7 @@ on them, so they are kept byte for byte (including the table's capitalisation).
 
 from __future__ import annotations
 
+from easynav.core import nav_state_keys as keys
 from easynav.core.nav_state_keys import (
     GOAL_TOLERANCE_HEIGHT,
     GOAL_TOLERANCE_POSITION,
@@ -47,11 +48,13 @@ MISSION_ABORTED = "Mission aborted"
 """ERROR text of ``abort_mission`` when it is given an empty reason."""
 
 # -- NavState keys and values ---------------------------------------------------------------------
-KEY_GOALS = "goals"
-KEY_NAVIGATION_STATE = "navigation_state"
-KEY_NAVIGATION_PAUSED = "navigation_paused"
-KEY_ROBOT_POSE = "robot_pose"
-KEY_PATH = "path"
+# The core keys (easynav.core.nav_state_keys); ``keys.NAVIGATION_PAUSED`` is the key, this
+# module's NAVIGATION_PAUSED the reply text.
+KEY_GOALS = keys.GOALS
+KEY_NAVIGATION_STATE = keys.NAVIGATION_STATE
+KEY_NAVIGATION_PAUSED = keys.NAVIGATION_PAUSED
+KEY_ROBOT_POSE = keys.ROBOT_POSE
+KEY_PATH = keys.PATH
 KEY_POSITION_TOLERANCE = GOAL_TOLERANCE_POSITION
 KEY_HEIGHT_TOLERANCE = GOAL_TOLERANCE_HEIGHT
 KEY_YAW_TOLERANCE = GOAL_TOLERANCE_YAW
