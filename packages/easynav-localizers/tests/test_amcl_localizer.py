@@ -199,3 +199,24 @@ def test_without_map_or_perceptions_it_predicts_only():
 def test_bad_parameters_fail_configuration(params, message):
     with pytest.raises(PluginConfigurationError, match=message):
         Sim(params)
+
+
+def test_scores_in_numpy_at_the_simple_stacks_size_and_compiled_beyond(monkeypatch):
+    # 200 particles × up to 360 scan points (the simple stack's playground params) do not load
+    # numba for the scoring alone (about 100 MB resident, issue #21); a large cloud does.
+    import easynav.localizers.particle_filter as pf
+
+    assert not pf.compiled_scoring_pays(200, 360)
+    assert pf.compiled_scoring_pays(2000, 360)
+    calls = []
+    real = pf.hit_fractions
+
+    def spy(poses, points_xy, grid, field=None, chunk=128, compiled=True):
+        calls.append((len(poses), compiled))
+        return real(poses, points_xy, grid, field, chunk, compiled)
+
+    monkeypatch.setattr("easynav.localizers.amcl_localizer.hit_fractions", spy)
+    for particles in (200, 2000):
+        sim = Sim(dict(SEED_PARAMS, num_particles=particles))
+        sim.step(0.0, 0.0, 0.02, correct=True)
+    assert calls == [(200, False), (2000, True)]

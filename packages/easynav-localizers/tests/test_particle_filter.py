@@ -168,3 +168,11 @@ def test_redrawn_particles_count_in_the_estimate_once_weighed():
     pf.weights[0] = 1.0
     pf.redraw(np.array([0]), np.array([[3.0, 3.0, 0.0]]))
     assert pf.estimate() == pytest.approx((3.0, 3.0, 0.0))
+
+
+def test_compiled_scoring_pays_from_the_threshold_on():
+    from easynav.localizers.particle_filter import COMPILED_SCORING_MIN_PAIRS, compiled_scoring_pays
+
+    assert not compiled_scoring_pays(1, COMPILED_SCORING_MIN_PAIRS - 1)
+    assert compiled_scoring_pays(1, COMPILED_SCORING_MIN_PAIRS)
+    assert not compiled_scoring_pays(0, 10**9)

@@ -25,6 +25,7 @@ from easynav.core.types import (
 )
 from easynav.localizers.particle_filter import (
     ParticleFilter2D,
+    compiled_scoring_pays,
     hit_fractions,
     likelihood_field,
 )
@@ -303,7 +304,9 @@ class AMCLLocalizer(LocalizerMethodBase):
         with self._lock:
             snapshot = self.filter.poses.copy()
             generation = self._generation
-        fractions, _ = hit_fractions(snapshot, points[:, :2], grid, self._field)
+        # Numpy at the usual sizes: this plugin alone would load numba for it (issue #21).
+        compiled = compiled_scoring_pays(len(snapshot), len(points))
+        fractions, _ = hit_fractions(snapshot, points[:, :2], grid, self._field, compiled=compiled)
         now = self.now()
         with self._lock:
             if generation == self._generation:  # not redrawn (initialpose) while scoring
