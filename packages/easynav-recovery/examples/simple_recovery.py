@@ -19,7 +19,12 @@ from __future__ import annotations
 import numpy as np
 
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import DictParameters, PluginContext, RecoveryActions
+from easynav.core.plugins import (
+    DictParameters,
+    PluginContext,
+    PluginServices,
+    RecoveryActions,
+)
 from easynav.core.sensors import PointPerception
 from easynav.core.types import (
     Goals,
@@ -79,16 +84,6 @@ class PrintingActions(RecoveryActions):
         return True
 
 
-def host_services(actions: RecoveryActions):
-    """The host services holding ``actions`` (a PluginServices; a dict in easynav-core
-    versions before it)."""
-    try:
-        from easynav.core.plugins import PluginServices
-    except ImportError:
-        return {"recovery_actions": actions}
-    return PluginServices(recovery_actions=actions)
-
-
 class World:
     """NavState, the clock, the manager and a unicycle robot on the x axis."""
 
@@ -100,7 +95,7 @@ class World:
             node_name="recovery_node",
             namespace="example",
             now=self.clock,
-            services=host_services(actions),
+            services=PluginServices(recovery_actions=actions),
         )
         self.manager = SimpleRecoveryManager()
         self.manager.initialize(context, "recovery_manager")
