@@ -111,3 +111,32 @@ def test_walls_rows_use_the_envelope_and_match_brute_force():
     data[25, 5] = 254
     expected = inflate_reference(data, 0.05, 1.0, 0.2, 2.0)
     assert np.array_equal(inflate(data, 0.05, 1.0, 0.2, 2.0), expected)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_compiled_distances_are_exact_within_the_cap_and_agree_with_opencv(seed):
+    # The costmap AMCL's likelihood field uses this transform instead of OpenCV's when numba is
+    # installed (the costmap stack then need not load OpenCV, issue #21).
+    import cv2
+
+    from easynav.maps import inflation
+
+    if not inflation.compiled():
+        pytest.skip("numba not installed: callers use OpenCV's transform")
+    rng = np.random.default_rng(300 + seed)
+    shape = (int(rng.integers(1, 70)), int(rng.integers(1, 70)))
+    obstacles = rng.random(shape) < float(rng.choice([0.002, 0.02, 0.3]))
+    obstacles[int(rng.integers(shape[0])), int(rng.integers(shape[1]))] = True
+    cap = int(rng.choice([1, 4, 15, 1000]))
+    distances = inflation.compiled_distances(obstacles, cap)
+    assert distances.dtype == np.float32 and distances.shape == shape
+    oy, ox = np.nonzero(obstacles)
+    yy, xx = np.mgrid[0 : shape[0], 0 : shape[1]]
+    squared = ((yy[..., None] - oy) ** 2 + (xx[..., None] - ox) ** 2).min(axis=2)
+    within = squared <= cap * cap
+    assert np.array_equal(distances[within], np.sqrt(squared[within].astype(np.float32)))
+    assert (distances[~within] > cap).all()
+    opencv = cv2.distanceTransform((~obstacles).astype(np.uint8), cv2.DIST_L2,
+                                   cv2.DIST_MASK_PRECISE)
+    # OpenCV's float square root may differ by one float32 rounding.
+    np.testing.assert_allclose(distances[within], opencv[within], rtol=2.5e-7, atol=0.0)

@@ -98,3 +98,40 @@ def test_real_nav2_map_loads_with_its_free_space():
     free = ~world.cells
     assert 0.02 < free.mean() < 0.2  # the sandbox's free area inside unknown surroundings
     assert not world.occupied_at(-2.0, -0.5)  # TurtleBot3's spawn point in the sandbox
+
+
+@pytest.mark.parametrize(
+    "header",
+    [b"P5\n7 5\n255\n", b"P5 7 5 255 ", b"P5\n# CREATOR: map_saver\n7 5\n# x\n255\n",
+     b"P5\t7\r\n5\n255\r"],
+)
+def test_binary_pgm_is_read_without_opencv_as_opencv_reads_it(tmp_path, header):
+    from easynav.maps.map_yaml import read_pgm
+
+    pixels = np.random.default_rng(len(header)).integers(0, 256, (5, 7), dtype=np.uint8)
+    path = tmp_path / "m.pgm"
+    path.write_bytes(header + pixels.tobytes())
+    image = read_pgm(path)
+    assert image.dtype == np.uint8 and np.array_equal(image, pixels)
+    assert np.array_equal(image, cv2.imread(str(path), cv2.IMREAD_UNCHANGED))
+
+
+@pytest.mark.parametrize(
+    "content",
+    [b"P5\n7 5\n65535\n" + bytes(70), b"P5\n7 5\n100\n" + bytes(35), b"P5\n7 5\n255\n" + bytes(3),
+     b"P2\n2 1\n255\n0 1\n", b"\x89PNG\r\n"],
+)
+def test_other_images_are_left_to_opencv(tmp_path, content):
+    from easynav.maps.map_yaml import read_pgm
+
+    path = tmp_path / "m.pgm"
+    path.write_bytes(content)
+    assert read_pgm(path) is None
+
+
+def test_a_map_saved_and_loaded_again_reads_the_same_pgm(tmp_path):
+    from easynav.maps.map_yaml import read_pgm
+
+    pixels = np.random.default_rng(3).integers(0, 256, (30, 41), dtype=np.uint8)
+    cv2.imwrite(str(tmp_path / "w.pgm"), pixels)
+    assert np.array_equal(read_pgm(tmp_path / "w.pgm"), pixels)

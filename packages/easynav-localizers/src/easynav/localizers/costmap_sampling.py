@@ -1,11 +1,11 @@
 """Helpers of the costmap AMCL: free-space sampling, the KLD particle count, the beam
-likelihood field. Plain numpy/OpenCV on Costmap2D values, no ROS."""
+likelihood field. Plain numpy (the costmap stack's compiled distance transform, else OpenCV's)
+on Costmap2D values, no ROS."""
 
 from __future__ import annotations
 
 import math
 
-import cv2
 import numpy as np
 
 from easynav.localizers.particle_filter import occupied_cells
@@ -77,14 +77,26 @@ def beam_likelihood_field(
     cubes: ``weight = 1 + Σ pz³``, much less peaked than a product over 60 beams). Returns the
     ``(height, width)`` float32 table and the ``pz³`` of a point off the map (``z_rand`` only).
 
-    The distance transform is OpenCV's exact Euclidean one (``DIST_MASK_PRECISE``).
+    The distance transform is exact Euclidean: with numba installed the compiled one of the
+    costmap inflation (:func:`easynav.maps.inflation.compiled_distances`, exact up to
+    ``max_dist``), else OpenCV's (``DIST_MASK_PRECISE``); they agree within a float32
+    rounding. The costmap stack loads numba anyway and so does not load OpenCV for this
+    (about 20 MB resident, issue #21).
     """
     rand = z_rand / max_range
     obstacles = occupied_cells(costmap)
     if obstacles.any():
-        free = (~obstacles).astype(np.uint8)
-        d = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) * costmap.resolution
-        d = np.minimum(d, max_dist)
+        from easynav.maps.inflation import compiled_distances
+
+        reach = max_dist / costmap.resolution
+        cap = math.ceil(reach) + 1 if math.isfinite(reach) else sum(obstacles.shape)
+        cells = compiled_distances(obstacles, cap)
+        if cells is None:
+            import cv2
+
+            free = (~obstacles).astype(np.uint8)
+            cells = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        d = np.minimum(cells * costmap.resolution, max_dist)
     else:
         d = np.full(obstacles.shape, max_dist, dtype=np.float32)
     pz = z_hit * np.exp(-0.5 * np.square(d / sigma_hit)) + rand

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 
-import cv2
 import numpy as np
 
 from easynav.core.types import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, NO_INFORMATION
@@ -79,7 +78,28 @@ def distance_to_lethal(data: np.ndarray) -> np.ndarray:
     free = np.not_equal(data, LETHAL_OBSTACLE).view(np.uint8)
     if free.size == 0:
         return np.zeros(free.shape, dtype=np.float32)
+    import cv2  # here: the compiled path does without OpenCV (about 20 MB resident, issue #21)
+
     return cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+
+
+def compiled_distances(obstacles: np.ndarray, cap: int) -> np.ndarray | None:
+    """Euclidean distance (cells, float32) of every cell to the nearest ``obstacles`` cell
+    (a 2-D bool array): the square root of the exact integer squared distance up to ``cap``
+    cells, larger than ``cap`` beyond. The compiled transform of :func:`inflate`; None without
+    numba (or for a ``cap`` the compiled path cannot hold), where callers use OpenCV's exact
+    transform, which agrees within a float32 rounding (OpenCV's own square root).
+
+    For a process that has numba loaded anyway and would load OpenCV for this alone.
+    """
+    obstacles = np.asarray(obstacles, dtype=bool)
+    if _compiled_distances is None or obstacles.ndim != 2:
+        return None
+    cap = int(min(cap, sum(obstacles.shape)))  # no distance on the grid exceeds height + width
+    if not 0 <= cap < _MAX_COMPILED_RADIUS:
+        return None
+    marks = np.ascontiguousarray(obstacles, dtype=np.uint8) * np.uint8(LETHAL_OBSTACLE)
+    return np.sqrt(_compiled_distances(marks, cap).astype(np.float32))
 
 
 def inflation_costs(data: np.ndarray, cell_radius: int, table: np.ndarray) -> np.ndarray:
@@ -243,6 +263,25 @@ def _row_envelope(row, sq, w, cap, v, z):  # pragma: no cover - compiled
         sq[q] = (q - p) * (q - p) + row[p] * row[p]
 
 
+def _squared_distances_kernel(data, cap):  # pragma: no cover - compiled
+    # Squared distance of every cell to the nearest lethal cell: exact up to cap², larger
+    # beyond (the column pass caps at cap + 1; columns beyond the cap add no parabola).
+    h, w = data.shape
+    g = _column_distances(data, cap)
+    out = np.empty((h, w), np.int64)
+    sq = np.empty(w, np.int64)
+    v = np.empty(w, np.int64)
+    z = np.empty(w + 1, np.float64)
+    row = np.empty(w, np.int64)
+    for y in range(h):
+        for x in range(w):
+            row[x] = g[y, x]
+        _row_envelope(row, sq, w, cap, v, z)
+        for x in range(w):
+            out[y, x] = sq[x]
+    return out
+
+
 def _inflate_kernel(data, cap, table, combine):  # pragma: no cover - compiled
     h, w = data.shape
     g = _column_distances(data, cap)
@@ -280,12 +319,14 @@ try:
     import numba
 except ImportError:  # the optional extra is missing: OpenCV serves
     _compiled_inflate = None
+    _compiled_distances = None
 else:
     _jit = numba.njit(cache=True, nogil=True)
     _column_distances = _jit(_column_distances)
     _row_bounded_search = _jit(_row_bounded_search)
     _row_envelope = _jit(_row_envelope)
     _compiled_inflate = _jit(_inflate_kernel)
+    _compiled_distances = _jit(_squared_distances_kernel)
 
 
 def compiled() -> bool:

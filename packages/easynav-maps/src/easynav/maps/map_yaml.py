@@ -21,7 +21,6 @@ import os
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 import yaml
 
@@ -159,8 +158,45 @@ def image_to_occupancy(
     return result
 
 
+_PGM_SPACE = b" \t\n\v\f\r"
+
+
+def read_pgm(path: str | os.PathLike) -> np.ndarray | None:
+    """The pixels of a binary 8-bit PGM (``P5``, maxval 255, the format map_saver writes) as
+    OpenCV's ``imread(IMREAD_UNCHANGED)`` gives them: ``(height, width)`` uint8, top row
+    first. None for any other file (another format or depth, a short file): OpenCV reads
+    those. A process that loads only such maps does not load OpenCV (about 20 MB resident).
+    """
+    raw = Path(path).read_bytes()
+    if raw[:2] != b"P5":
+        return None
+    fields: list[int] = []
+    i, n = 2, len(raw)
+    while len(fields) < 3:
+        while i < n and raw[i] in _PGM_SPACE:
+            i += 1
+        if i < n and raw[i] == ord("#"):  # a comment runs to the end of its line
+            while i < n and raw[i] not in b"\r\n":
+                i += 1
+            continue
+        start = i
+        while i < n and 48 <= raw[i] <= 57:
+            i += 1
+        if i == start:
+            return None
+        fields.append(int(raw[start:i]))
+    if i >= n or raw[i] not in _PGM_SPACE:
+        return None
+    width, height, maxval = fields
+    start = i + 1  # one whitespace character ends the header
+    if maxval != 255 or width < 1 or height < 1 or n - start < width * height:
+        return None
+    return np.frombuffer(raw, np.uint8, width * height, start).reshape(height, width).copy()
+
+
 def load_map_yaml(path: str | os.PathLike, frame_id: str = "map") -> OccupancyGrid:
-    """Load a ROS map_server map (YAML + image, read with OpenCV) as an :class:`OccupancyGrid`.
+    """Load a ROS map_server map (YAML + image, read with OpenCV, an 8-bit binary PGM with
+    :func:`read_pgm`) as an :class:`OccupancyGrid`.
 
     Raises :class:`FileNotFoundError` (YAML or image missing, naming it) or
     :class:`MapFormatError` (bad key, unreadable image), naming the file.
@@ -169,7 +205,11 @@ def load_map_yaml(path: str | os.PathLike, frame_id: str = "map") -> OccupancyGr
     image_path: Path = info["image"]
     if not image_path.is_file():
         raise FileNotFoundError(f"map image not found: {image_path} (named by {path})")
-    image = cv2.imread(str(image_path), cv2.IMREAD_UNCHANGED)
+    image = read_pgm(image_path)
+    if image is None:
+        import cv2  # here: the usual 8-bit PGM maps are read without OpenCV (issue #21)
+
+        image = cv2.imread(str(image_path), cv2.IMREAD_UNCHANGED)
     if image is None:
         raise MapFormatError(f"{image_path}: OpenCV cannot read this image (named by {path})")
     # OpenCV orders channels BGR(A): the mean of the colours does not care, alpha stays last.
@@ -230,6 +270,8 @@ def save_map_yaml(
     image_path = yaml_path.with_suffix(".pgm")
     pixels = occupancy_to_trinary_image(grid.data, free_thresh, occupied_thresh)
     yaml_path.parent.mkdir(parents=True, exist_ok=True)
+    import cv2
+
     if not cv2.imwrite(str(image_path), pixels):
         raise OSError(f"cannot write map image {image_path}")
     doc = {

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 
-import cv2
 import numpy as np
 
 from easynav.maps import SimpleMap
@@ -72,6 +71,8 @@ class SimpleGridPlanner:
         """``(height, width)`` int8 levels (FREE, CLEARANCE, COLLISION, OBSTACLE) of a map."""
         # Distance (in cells, between centres) to the nearest occupied cell, with a ring of
         # occupied cells around the map so that the unknown beyond its edge keeps clear too.
+        import cv2  # here: importing the planners package does not load OpenCV (issue #21)
+
         free = np.pad(~coarse.cells, 1, constant_values=False).astype(np.uint8)
         distance = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
         cells_per_m = 1.0 / coarse.resolution
