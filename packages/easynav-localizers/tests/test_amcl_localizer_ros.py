@@ -24,6 +24,7 @@ def test_odom_initialpose_tf_and_particles(ros):
     from easynav.core.sensors import PointPerception
     from easynav.core.tf import get_tf_buffer
     from easynav.core.types import Header, Transform, TransformStamped
+    from easynav.system.localizer_node import subscribe_initial_pose
 
     namespace = "amcl_ros_test"
     context = PluginContext(
@@ -34,6 +35,8 @@ def test_odom_initialpose_tf_and_particles(ros):
     )
     amcl = AMCLLocalizer()
     amcl.initialize(context, "simple")
+    # What localizer_node does for its localizer: initialpose reaches the plugin's base.
+    subscribe_initial_pose(ros.node, lambda: [amcl])
     nav_state = NavState()
 
     tf_messages, particles = [], []

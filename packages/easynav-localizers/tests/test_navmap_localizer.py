@@ -469,6 +469,8 @@ def test_over_ros_odom_initialpose_tf_and_particles_with_height(ros):
     from nav_msgs.msg import Odometry as OdometryMsg
     from tf2_msgs.msg import TFMessage
 
+    from easynav.system.localizer_node import subscribe_initial_pose
+
     namespace = f"navmap_amcl_ros_{next(_namespaces)}"
     get_tf_buffer(namespace).set_transform(
         TransformStamped(Header(0.0, "base_footprint"), "lidar",
@@ -477,6 +479,8 @@ def test_over_ros_odom_initialpose_tf_and_particles_with_height(ros):
     amcl.initialize(PluginContext(parameters=DictParameters({"navmap.num_particles": 50}),
                                   node=ros.node, namespace=namespace, now=lambda: 20.0),
                     "navmap")
+    # What localizer_node does for its localizer: initialpose reaches the plugin's base.
+    subscribe_initial_pose(ros.node, lambda: [amcl])
     nav_state = NavState()
     nav_state.set("map.navmap", NAVMAP)
     nav_state.set("map.bonxai", VOXELS)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -36,10 +37,8 @@ class LocalizerNode(ComponentNode):
 
     def after_plugins_loaded(self) -> None:
         if self.plugins and self._initial_pose_subscription is None:
-            from geometry_msgs.msg import PoseWithCovarianceStamped
-
-            self._initial_pose_subscription = self.create_subscription(
-                PoseWithCovarianceStamped, INITIAL_POSE_TOPIC, self._on_initial_pose, 10
+            self._initial_pose_subscription = subscribe_initial_pose(
+                self, lambda: [lp.plugin for lp in self.plugins]
             )
         if not self.nav_state.has(ROBOT_POSE):
             return
@@ -54,10 +53,6 @@ class LocalizerNode(ComponentNode):
         if subscription is not None:
             self.destroy_subscription(subscription)
 
-    def _on_initial_pose(self, msg: Any) -> None:
-        for lp in self.plugins:
-            lp.plugin.handle_initial_pose(*initial_pose_values(msg))
-
     def cycle_rt(self, trigger: bool) -> bool:
         """Predict when due or triggered; True when the localizer ran. RT thread."""
         if not self.active:
@@ -68,6 +63,24 @@ class LocalizerNode(ComponentNode):
         """Correct when due. Non-RT thread."""
         if self.active:
             self.run_scheduled(rt=False)
+
+
+def subscribe_initial_pose(node: Any, localizers: Callable[[], Iterable[Any]]) -> Any:
+    """Subscribe ``initialpose`` (PoseWithCovarianceStamped, relative, depth 10) on ``node``;
+    each message goes to the ``handle_initial_pose`` of every localizer ``localizers()`` gives
+    (which checks it and never raises). Returns the subscription, for the caller to destroy.
+
+    localizer_node does this for its localizer; a script or a test that hosts a localizer on a
+    node of its own calls it the same way.
+    """
+    from geometry_msgs.msg import PoseWithCovarianceStamped
+
+    def deliver(msg: Any) -> None:
+        values = initial_pose_values(msg)
+        for localizer in localizers():
+            localizer.handle_initial_pose(*values)
+
+    return node.create_subscription(PoseWithCovarianceStamped, INITIAL_POSE_TOPIC, deliver, 10)
 
 
 def initial_pose_values(msg: Any) -> tuple[str, float, Any, np.ndarray]:
