@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from easynav.controllers.mppi.collision_model import CollisionModel
 from easynav.core.robot import RobotLimits
 from easynav.core.types import Costmap2D
 
@@ -19,7 +20,8 @@ class MppiBatch:
     (``path_xy`` P×2, ``path_yaw`` P, ``path_s`` P arc length from the robot's projection) starts
     at the robot's projection on the global path; ``path_is_final`` says whether it ends at the
     goal. ``goal`` is (x, y, yaw) of the last path pose, ``goal_dist`` the robot's straight
-    distance to it. ``costmap`` is None when NavState has no ``map``.
+    distance to it. ``costmap`` is None when NavState has no ``map``; ``collision`` is the cycle's
+    collision test over it (None: the CostCritic tests the cells under the poses only).
 
     Thread contract: built and scored in the RT thread; never shared.
     """
@@ -41,6 +43,7 @@ class MppiBatch:
     goal: tuple[float, float, float]
     goal_dist: float
     costmap: Costmap2D | None = None
+    collision: CollisionModel | None = None
     _furthest: int | None = field(default=None, repr=False)
 
     @property

@@ -120,6 +120,7 @@ class MPPIController(ControllerMethodBase):
             float(nav_state.get_or(GOAL_TOLERANCE_YAW, self.params.yaw_goal_tolerance)),
             costmap if isinstance(costmap, Costmap2D) else None,
             path_key=path,
+            robot_radius=self.get_robot_geometry().radius,
         )
         self.state = command.state
         self.last_command = command

@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from easynav.controllers.mppi.collision_model import CollisionModel
 from easynav.controllers.mppi.critic import Critic
 from easynav.controllers.mppi.critics import CRITICS, DEFAULT_CRITICS
-from easynav.controllers.mppi.critics.cost_critic import rollout_costs
 from easynav.controllers.mppi.mppi_batch import MppiBatch
 from easynav.controllers.mppi.noise_generator import NoiseGenerator
 from easynav.controllers.mppi.rollout import constrain_and_integrate
@@ -24,12 +24,7 @@ from easynav.controllers.regulated_pp.path_geometry import project_on_path
 from easynav.controllers.regulated_pp.regulation import latched_angle, rotation_speed
 from easynav.core.plugins import Param
 from easynav.core.robot import RobotLimits
-from easynav.core.types import (
-    INSCRIBED_INFLATED_OBSTACLE,
-    NO_INFORMATION,
-    Costmap2D,
-    normalize_angle,
-)
+from easynav.core.types import Costmap2D, normalize_angle
 
 NAN = math.nan
 
@@ -161,8 +156,11 @@ class MppiOptimizer:
     integrated as a unicycle, the critics add their costs (plus Nav2's control cost ``gamma``),
     and the new sequence is the softmin-weighted mean (temperature ``lambda``), Savitzky–Golay
     smoothed with the last applied commands and constrained again. Its first command is applied,
-    unless its rollout enters an inscribed or lethal cell: then the best sample's (state
-    ``fallback``), and when that collides too the robot brakes (state ``blocked``).
+    unless its rollout collides (:class:`CollisionModel`: an inscribed or lethal cell, or an
+    obstacle within ``robot_radius`` + ``CostCritic.collision_margin``, or as near as the
+    path goes): then the best
+    sample's (state ``fallback``), and when that collides too the robot brakes (state
+    ``blocked``).
     Inside the goal's xy tolerance it rotates in place to the goal yaw and stops within the yaw
     tolerance.
 
@@ -210,6 +208,7 @@ class MppiOptimizer:
         self._at_goal_xy = False
         self._rotating = False
         self._rotation_sign = 0.0
+        self._held: float | None = None  # the CollisionModel's hold inside the margin
         self.last_batch: MppiBatch | None = None
 
     # -- path ----------------------------------------------------------------------------------
@@ -242,8 +241,10 @@ class MppiOptimizer:
         yaw_tolerance: float,
         costmap: Costmap2D | None = None,
         path_key: Any = None,
+        robot_radius: float = 0.0,
     ) -> MppiCommand:
-        """The command for this cycle; ``elapsed`` is the time since the previous one (s)."""
+        """The command for this cycle; ``elapsed`` is the time since the previous one (s);
+        ``robot_radius`` (m) is the disc kept, with the margin, off obstacle cells."""
         p = self.params
         if len(path_xy_yaw) == 0:
             self.reset()
@@ -313,6 +314,11 @@ class MppiOptimizer:
         # are held within the accelerations from the current command below.
         sample_bounds = bounds[:3] + (math.inf,) * 4
         std = np.array((p["vx_std"], p["wz_std"]), dtype=np.float32)
+        collision = None if costmap is None else CollisionModel(
+            costmap, pose, max(max_v, abs(limits.min_linear_vel)) * steps * dt, robot_radius,
+            p["CostCritic.collision_margin"], p["CostCritic.consider_unknown_lethal"], path_xy,
+            self._held)
+        self._held = None if collision is None else collision.held
         batch = None
         for _ in range(p["iteration_count"]):
             # White noise per step averages out over the horizon (a 56-step sample ends within
@@ -329,6 +335,7 @@ class MppiOptimizer:
             batch = MppiBatch(
                 vx, wz, x, y, yaw, np.zeros(len(vx), dtype=np.float32), dt, pose, self.last,
                 limits, path_xy, path_yaw, path_s, is_final, goal, goal_dist, costmap,
+                collision,
             )
             for critic in self.critics:
                 critic.score(batch)
@@ -349,14 +356,14 @@ class MppiOptimizer:
         w_seq = self.sequence[None, :, 1].copy()
         ox, oy, oyaw = constrain_and_integrate(v_seq, w_seq, pose, self.last, dt, bounds)
         state = FOLLOWING
-        if costmap is not None and self._collides(costmap, ox[0], oy[0]):
+        if collision is not None and collision.rollout_collides(ox[0], oy[0]):
             # The weighted mean of collision-free samples (two ways round an obstacle) may
             # itself collide: fall back to the best sample, held within the accelerations.
             best = int(np.argmin(batch.costs))
             v_seq = batch.vx[best][None].copy()
             w_seq = batch.wz[best][None].copy()
             ox, oy, oyaw = constrain_and_integrate(v_seq, w_seq, pose, self.last, dt, bounds)
-            if self._collides(costmap, ox[0], oy[0]):
+            if collision.rollout_collides(ox[0], oy[0]):
                 # Nothing safe in reach: brake and start the next optimisation afresh.
                 self.sequence[:] = 0.0
                 self.last_batch = batch
@@ -370,15 +377,6 @@ class MppiOptimizer:
         self.last_batch = batch
         optimal = np.column_stack((ox[0], oy[0], oyaw[0]))
         return self._apply(float(v_seq[0, 0]), float(w_seq[0, 0]), state, optimal)
-
-    def _collides(self, costmap: Costmap2D, x: np.ndarray, y: np.ndarray) -> bool:
-        """Whether a rollout enters an inscribed or lethal cell (or unknown space, as the
-        CostCritic's ``consider_unknown_lethal`` says)."""
-        costs = rollout_costs(costmap, x, y)
-        lethal = costs >= INSCRIBED_INFLATED_OBSTACLE
-        if not self.params["CostCritic.consider_unknown_lethal"]:
-            lethal &= costs != NO_INFORMATION
-        return bool(lethal.any())
 
     def _latch(self, angle: float) -> float:
         # Keep turning the way a rotation in place started while the target is near ±π.

@@ -4,36 +4,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from easynav.controllers.mppi.collision_model import CollisionModel, rollout_costs
 from easynav.controllers.mppi.critic import Critic
 from easynav.controllers.mppi.mppi_batch import MppiBatch
 from easynav.core.plugins import Param
-from easynav.core.types import (
-    INSCRIBED_INFLATED_OBSTACLE,
-    LETHAL_OBSTACLE,
-    NO_INFORMATION,
-    Costmap2D,
-)
+from easynav.core.types import LETHAL_OBSTACLE
 
-
-def rollout_costs(costmap: Costmap2D, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Costmap values (uint8) at the points ``(x, y)``; off the map: NO_INFORMATION."""
-    ix = np.floor((x - np.float32(costmap.origin_x)) * np.float32(1.0 / costmap.resolution))
-    iy = np.floor((y - np.float32(costmap.origin_y)) * np.float32(1.0 / costmap.resolution))
-    ix = ix.astype(np.int32)
-    iy = iy.astype(np.int32)
-    inside = (ix >= 0) & (ix < costmap.width) & (iy >= 0) & (iy < costmap.height)
-    np.clip(ix, 0, costmap.width - 1, out=ix)
-    np.clip(iy, 0, costmap.height - 1, out=iy)
-    costs = costmap.data[iy, ix]
-    costs[~inside] = NO_INFORMATION
-    return costs
+__all__ = ["CostCritic", "rollout_costs"]
 
 
 class CostCritic(Critic):
     """Costs of the cells under every ``trajectory_point_step``-th rollout pose.
 
-    A rollout through an inscribed or lethal cell (or unknown space with
-    ``consider_unknown_lethal``, or off the map) collides: ``collision_cost`` is added, unweighted.
+    A rollout collides (:class:`CollisionModel`) when one of those poses is on an inscribed or
+    lethal cell (or unknown space with ``consider_unknown_lethal``, or off the map), or nearer
+    than ``robot_geometry.radius + collision_margin`` to an obstacle cell: ``collision_cost``
+    is added, unweighted.
     Otherwise ``(cost_weight · Σ (cost / 254) / points)^cost_power``, except within
     ``near_goal_distance`` of the goal (a goal near a wall stays reachable). No costmap in
     NavState: no term.
@@ -47,16 +33,20 @@ class CostCritic(Critic):
               "m", ge=0.0),
         Param("trajectory_point_step", 2, "score every n-th rollout pose", ge=1),
         Param("consider_unknown_lethal", True, "unknown cells (255) count as collisions"),
+        Param("collision_margin", 0.05,
+              "clearance kept between the robot's disc (robot_geometry.radius) and obstacle "
+              "cells, for the localisation and tracking errors (beyond Nav2)", "m", ge=0.0),
     )
 
     def score(self, batch: MppiBatch) -> None:
         if not self.param("enabled") or batch.costmap is None:
             return
         step = self.param("trajectory_point_step")
-        costs = rollout_costs(batch.costmap, batch.x[:, ::step], batch.y[:, ::step])
-        lethal = costs >= INSCRIBED_INFLATED_OBSTACLE
-        if not self.param("consider_unknown_lethal"):
-            lethal &= costs != NO_INFORMATION
+        x, y = batch.x[:, ::step], batch.y[:, ::step]
+        costs = rollout_costs(batch.costmap, x, y)
+        collision = batch.collision or CollisionModel(
+            batch.costmap, batch.pose, 0.0, 0.0, 0.0, self.param("consider_unknown_lethal"))
+        lethal = collision.colliding(x, y, costs)
         collided = lethal.any(axis=1)
         batch.costs += np.float32(self.param("collision_cost")) * collided
         if batch.path_is_final and batch.goal_dist < self.param("near_goal_distance"):
