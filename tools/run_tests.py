@@ -22,7 +22,7 @@ BIN = Path(sys.executable).parent
 #: The isolated installs: the kernel and one plugin distribution, each Python with the lowest or
 #: the highest sibling versions their ranges allow.
 ISOLATED = (("3.10", "lowest"), ("3.13", "highest"))
-ISOLATED_PACKAGES = ("easynav-core", "easynav-planners")
+ISOLATED_PACKAGES = ("easynav-core", "easynav-common", "easynav-planners")
 
 
 def find_python(version: str) -> str | None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 import yaml
 
-from easynav.core.tf import get_tf_buffer
+from easynav.common.tf import get_tf_buffer
 from easynav.system.testing.system_fixtures import system_params
 
 pytestmark = pytest.mark.ros

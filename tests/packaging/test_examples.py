@@ -62,6 +62,7 @@ EXPECTED: dict[str, list[str]] = {
 #: Distributions whose examples these are, and the import package of each sibling.
 MODULE_OF = {
     "easynav-core": "easynav.core",
+    "easynav-common": "easynav.common",
     "easynav-maps": "easynav.maps",
     "easynav-localizers": "easynav.localizers",
     "easynav-planners": "easynav.planners",

@@ -18,7 +18,7 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 PACKAGES = REPO / "packages"
 KERNEL_AND_PLUGINS = [
-    "easynav-core", "easynav-maps", "easynav-localizers", "easynav-planners",
+    "easynav-core", "easynav-common", "easynav-maps", "easynav-localizers", "easynav-planners",
     "easynav-controllers", "easynav-recovery", "easynav-faulty",
 ]
 GROUPS = [
@@ -28,7 +28,7 @@ GROUPS = [
 
 pytestmark = [
     pytest.mark.slow,
-    # Seven wheels built and installed with numpy, opencv and PyYAML (from pip's cache when it
+    # Eight wheels built and installed with numpy, opencv and PyYAML (from pip's cache when it
     # has them), then eight examples: a few minutes on a loaded machine.
     pytest.mark.timeout(900),
 ]

@@ -1,5 +1,6 @@
-"""The runtime with the kernel and the interfaces alone (easynav-system, easynav-core,
-easynav-interfaces), in a fresh environment, runs the Dummy system."""
+"""The runtime with the kernel, the common part and the interfaces alone (easynav-system,
+easynav-core, easynav-common, easynav-interfaces), in a fresh environment, runs the Dummy
+system."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ REPO = Path(__file__).resolve().parents[2]
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.ros,
-    # Builds the interfaces' wheel (rosidl code generation) and installs three distributions into
+    # Builds the interfaces' wheel (rosidl code generation) and installs four distributions into
     # a fresh venv: about a minute on a quiet machine; at a load of 20 (a soak beside the suite)
     # it passed the suite's 300 s watchdog while still generating messages.
     pytest.mark.timeout(900),
@@ -43,12 +44,13 @@ def test_runtime_kernel_and_interfaces_alone_run_the_dummy_system(tmp_path):
     run(pip + ["--upgrade", "pip"], timeout=300)
     wheel = next(wheels.glob("easynav_interfaces-*.whl"))
     run(pip + [str(wheel), str(REPO / "packages" / "easynav-core"),
+               str(REPO / "packages" / "easynav-common"),
                str(REPO / "packages" / "easynav-system")], timeout=900)
 
     listed = run([str(venv / "bin" / "pip"), "list", "--format=freeze"]).stdout
     easynav = sorted(line.split("==")[0] for line in listed.splitlines()
                      if line.lower().startswith("easynav"))
-    assert easynav == ["easynav-core", "easynav-interfaces", "easynav-system"]
+    assert easynav == ["easynav-common", "easynav-core", "easynav-interfaces", "easynav-system"]
 
     plugins = run([str(venv / "bin" / "easynav"), "plugins"], timeout=60).stdout
     assert "easynav_controller/DummyController" in plugins

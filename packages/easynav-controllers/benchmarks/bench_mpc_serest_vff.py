@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
 from easynav.controllers.mpc_controller import MPCController
 from easynav.controllers.serest_controller import SerestController
 from easynav.controllers.simple_controller import SimpleController
@@ -24,7 +25,6 @@ from easynav.core.benchmarking import BenchRow, add_json_option, percentiles, re
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
 from easynav.core.robot import RobotLimits
-from easynav.core.sensors import PointPerception
 from easynav.core.types import Costmap2D, Header, Odometry, Path, Pose
 from easynav.system.colision_checker import ColisionChecker
 

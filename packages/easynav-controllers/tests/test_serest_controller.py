@@ -19,13 +19,13 @@ from closed_loop import (
     straight_path,
 )
 
+from easynav.common.sensors import PointPerception
 from easynav.controllers.obstacle_distance import closest_lethal_distance
 from easynav.controllers.serest_controller import SerestController
 from easynav.controllers.serest_tracker import SEREST_DEFAULTS, SerestTracker
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
 from easynav.core.robot import RobotLimits
-from easynav.core.sensors import PointPerception
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D, TwistStamped
 
 LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0)

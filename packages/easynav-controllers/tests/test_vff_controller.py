@@ -19,12 +19,12 @@ from closed_loop import (
     straight_path,
 )
 
+from easynav.common.sensors import PointPerception
 from easynav.controllers.vff_controller import VffController
 from easynav.controllers.vff_vectors import VffVectors
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
 from easynav.core.robot import RobotLimits
-from easynav.core.sensors import PointPerception
 from easynav.core.types import Goals, Header, Pose, PoseStamped, TwistStamped
 
 LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0)

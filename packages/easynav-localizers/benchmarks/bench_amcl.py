@@ -18,11 +18,11 @@ import time
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.benchmarking import BenchRow, add_json_option, report
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Pose, Transform, TransformStamped
 from easynav.localizers.amcl_localizer import AMCLLocalizer
 from easynav.localizers.particle_filter import likelihood_field

@@ -24,11 +24,11 @@ import time
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.benchmarking import BenchRow, add_json_option, percentiles, report
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Odometry, Pose, Transform, TransformStamped
 from easynav.localizers.costmap_amcl_localizer import CostmapAMCLLocalizer
 from easynav.localizers.costmap_sampling import beam_likelihood_field

@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Pose, Transform, TransformStamped, Twist
 from easynav.localizers.amcl_localizer import AMCLLocalizer
 from easynav.maps import SimpleMap, resolve_map_file

@@ -21,8 +21,8 @@ def test_odom_initialpose_tf_and_particles(ros):
     from nav_msgs.msg import Odometry as OdometryMsg
     from tf2_msgs.msg import TFMessage
 
-    from easynav.core.sensors import PointPerception
-    from easynav.core.tf import get_tf_buffer
+    from easynav.common.sensors import PointPerception
+    from easynav.common.tf import get_tf_buffer
     from easynav.core.types import Header, Transform, TransformStamped
     from easynav.system.localizer_node import subscribe_initial_pose
 

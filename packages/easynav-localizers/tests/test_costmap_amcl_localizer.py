@@ -9,10 +9,10 @@ import math
 import numpy as np
 import pytest
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Odometry, Pose, Transform, TransformStamped
 from easynav.localizers.costmap_amcl_localizer import CostmapAMCLLocalizer
 from easynav.localizers.costmap_sampling import (

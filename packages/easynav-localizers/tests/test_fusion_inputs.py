@@ -12,15 +12,15 @@ import pytest
 pytest.importorskip("filterpy")
 pytest.importorskip("pyproj")
 
+from easynav.common.sensors import GNSSPerception, ImuPerception  # noqa: E402
+from easynav.common.sensors.gnss_perception import (  # noqa: E402
+    COVARIANCE_TYPE_DIAGONAL_KNOWN,
+    STATUS_FIX,
+)
 from easynav.core.plugins import (  # noqa: E402
     DictParameters,
     PluginConfigurationError,
     PluginContext,
-)
-from easynav.core.sensors import GNSSPerception, ImuPerception  # noqa: E402
-from easynav.core.sensors.gnss_perception import (  # noqa: E402
-    COVARIANCE_TYPE_DIAGONAL_KNOWN,
-    STATUS_FIX,
 )
 from easynav.core.types import Header, Odometry, Pose, yaw_to_quaternion  # noqa: E402
 from easynav.localizers.fusion.fusion_filter import (  # noqa: E402
@@ -365,8 +365,8 @@ def test_pose_use_child_frame_reads_the_mount_from_tf_and_is_a_known_key():
     """The plugin: ``odom0_pose_use_child_frame`` (robot_localization's key) reaches the
     input, and the child -> robot transform comes from EasyNav's TF buffer
     (base_footprint -> odom_sensor, static)."""
+    from easynav.common.tf import get_tf_buffer
     from easynav.core.nav_state import NavState
-    from easynav.core.tf import get_tf_buffer
     from easynav.core.types import Transform, TransformStamped
 
     assert FusionLocalizer.unknown_parameter_keys(

@@ -11,16 +11,16 @@ import pytest
 pytest.importorskip("filterpy")
 pytest.importorskip("pyproj")
 
+from easynav.common.sensors import GNSSPerception, ImuPerception  # noqa: E402
+from easynav.common.sensors.gnss_perception import (  # noqa: E402
+    COVARIANCE_TYPE_DIAGONAL_KNOWN,
+    STATUS_FIX,
+)
 from easynav.core.nav_state import NavState  # noqa: E402
 from easynav.core.plugins import (  # noqa: E402
     DictParameters,
     PluginConfigurationError,
     PluginContext,
-)
-from easynav.core.sensors import GNSSPerception, ImuPerception  # noqa: E402
-from easynav.core.sensors.gnss_perception import (  # noqa: E402
-    COVARIANCE_TYPE_DIAGONAL_KNOWN,
-    STATUS_FIX,
 )
 from easynav.core.types import Header, Odometry, Pose, Twist, yaw_to_quaternion  # noqa: E402
 from easynav.localizers.fusion.ukf_filter import (  # noqa: E402
@@ -277,7 +277,7 @@ def test_map_to_odom_uses_the_odometry_transform_at_the_estimates_time():
     be newer (the inputs queue while the RT loop is late). map -> odom is estimate ∘ (odom ->
     robot)⁻¹ at the estimate's time: with the newest transform it is off by what the robot
     drove in between (here 1 m)."""
-    from easynav.core.tf import get_tf_buffer
+    from easynav.common.tf import get_tf_buffer
     from easynav.core.types import Transform, TransformStamped
 
     params = {
@@ -323,7 +323,7 @@ def test_map_to_odom_when_the_odometry_transform_lags_the_estimate():
     ``odom -> robot`` transforms (the TF listener lags under load). The estimate is moved back
     to the newest transform's stamp at its own velocity before the two are composed; composed
     as they were, the robot stood 0.4 m ahead of itself on map -> odom -> robot."""
-    from easynav.core.tf import TFBuffer
+    from easynav.common.tf import TFBuffer
     from easynav.core.types import Transform, TransformStamped
     from easynav.localizers.map_to_odom import map_to_odom
 

@@ -9,14 +9,14 @@ import pytest
 
 pytest.importorskip("pyproj")
 
-from easynav.core.nav_state import NavState  # noqa: E402
-from easynav.core.plugins import DictParameters, PluginContext  # noqa: E402
-from easynav.core.sensors import GNSSPerception, ImuPerception  # noqa: E402
-from easynav.core.sensors.gnss_perception import (  # noqa: E402
+from easynav.common.sensors import GNSSPerception, ImuPerception  # noqa: E402
+from easynav.common.sensors.gnss_perception import (  # noqa: E402
     COVARIANCE_TYPE_DIAGONAL_KNOWN,
     STATUS_FIX,
     STATUS_NO_FIX,
 )
+from easynav.core.nav_state import NavState  # noqa: E402
+from easynav.core.plugins import DictParameters, PluginContext  # noqa: E402
 from easynav.core.types import Odometry, yaw_to_quaternion  # noqa: E402
 from easynav.localizers.fusion.utm_projection import UtmProjection  # noqa: E402
 from easynav.localizers.gps_localizer import GpsLocalizer  # noqa: E402

@@ -11,16 +11,16 @@ import pytest
 pytest.importorskip("gtsam")
 pytest.importorskip("pyproj")
 
+from easynav.common.sensors import GNSSPerception, ImuPerception  # noqa: E402
+from easynav.common.sensors.gnss_perception import (  # noqa: E402
+    COVARIANCE_TYPE_DIAGONAL_KNOWN,
+    STATUS_FIX,
+)
 from easynav.core.nav_state import NavState  # noqa: E402
 from easynav.core.plugins import (  # noqa: E402
     DictParameters,
     PluginConfigurationError,
     PluginContext,
-)
-from easynav.core.sensors import GNSSPerception, ImuPerception  # noqa: E402
-from easynav.core.sensors.gnss_perception import (  # noqa: E402
-    COVARIANCE_TYPE_DIAGONAL_KNOWN,
-    STATUS_FIX,
 )
 from easynav.core.types import Header, Odometry, Pose, yaw_to_quaternion  # noqa: E402
 from easynav.localizers.fusion.utm_projection import UtmProjection  # noqa: E402

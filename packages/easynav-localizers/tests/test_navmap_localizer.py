@@ -10,10 +10,10 @@ import math
 import numpy as np
 import pytest
 
+from easynav.common.sensors import ImuPerception, PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
-from easynav.core.sensors import ImuPerception, PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Pose, Transform, TransformStamped
 from easynav.core.types.quaternion import quaternion_to_matrix
 from easynav.localizers import navmap_amcl_localizer as module

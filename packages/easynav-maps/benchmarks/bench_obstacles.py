@@ -19,11 +19,11 @@ import time
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.benchmarking import BenchRow, add_json_option, report
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Transform, TransformStamped
 from easynav.maps.costmap.obstacles_filter import ObstaclesFilter
 from easynav.maps.ray_casting import (

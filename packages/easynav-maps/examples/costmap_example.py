@@ -20,10 +20,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Odometry, Pose, Transform, TransformStamped
 from easynav.maps.costmap import MAP, MAP_BASE, SPEED_LIMIT
 from easynav.maps.costmap.costmap_maps_manager import CostmapMapsManager

@@ -9,12 +9,12 @@ import cv2
 import numpy as np
 import pytest
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
 from easynav.core.plugins.discovery import load_plugin_class
 from easynav.core.plugins.plugin_kinds import MAPS_MANAGER
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Transform, TransformStamped
 from easynav.maps.navmap import NavMap
 from easynav.maps.navmap.inflation_filter import (

@@ -7,10 +7,10 @@ import cv2
 import numpy as np
 import pytest
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Transform, TransformStamped
 from easynav.maps import OccupancyGrid
 from easynav.maps.navmap.keys import MAP_NAVMAP

@@ -10,11 +10,11 @@ import cv2
 import numpy as np
 import pytest
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
 from easynav.core.robot import RobotGeometry
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Transform, TransformStamped
 from easynav.maps.costmap import MAP, MAP_BASE
 from easynav.maps.voxel.bonxai_map import BonxaiMap

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
 from easynav.core.robot import RobotGeometry
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Transform, TransformStamped
 from easynav.maps import OccupancyGrid
 from easynav.maps.costmap import MAP_BASE

@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext
 from easynav.core.robot import RobotGeometry
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Transform, TransformStamped
 from easynav.maps.costmap import MAP
 from easynav.playground.sim import (

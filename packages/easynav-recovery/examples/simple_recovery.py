@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import (
     DictParameters,
@@ -25,7 +26,6 @@ from easynav.core.plugins import (
     PluginServices,
     RecoveryActions,
 )
-from easynav.core.sensors import PointPerception
 from easynav.core.types import (
     Goals,
     Header,

@@ -13,10 +13,10 @@ from typing import Any
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginContext, PluginServices, RecoveryActions
 from easynav.core.robot import RobotGeometry, RobotLimits
-from easynav.core.sensors import PointPerception
 from easynav.core.types import (
     Goals,
     Header,

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from recovery_harness import RecordingActions, make_context, scan
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticLevel, Header, Transform, TransformStamped, Twist
 from easynav.recovery.diagnostic.reflexes import CollisionSafetyReflex
 from easynav.recovery.diagnostic.reflexes.collision_safety_reflex import first_collision

@@ -16,10 +16,10 @@ from recovery_harness import (
     set_pose,
 )
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
     DiagnosticLevel,
     DiagnosticStatus,

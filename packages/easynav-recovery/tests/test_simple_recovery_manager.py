@@ -17,9 +17,9 @@ from recovery_harness import (
     set_pose,
 )
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.plugins import PluginConfigurationError, PluginServices
 from easynav.core.robot import RobotGeometry
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
     DiagnosticLevel,
     DiagnosticStatus,

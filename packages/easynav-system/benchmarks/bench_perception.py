@@ -25,9 +25,9 @@ from collections.abc import Callable
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import TFBuffer
 from easynav.core.benchmarking import BenchRow, add_json_option, report
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.tf import TFBuffer
 from easynav.system.process_tuning import tune_malloc
 from easynav.system.sensors.converters import points_from_point_cloud2
 from easynav.system.sensors.handlers import LaserScanHandler, PointCloud2Handler

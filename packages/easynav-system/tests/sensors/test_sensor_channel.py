@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from sensor_test_helpers import make_cloud, make_imu, make_scan
 
+from easynav.common.sensors import PointPerception
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters
-from easynav.core.sensors import PointPerception
 from easynav.system.sensors import SensorChannel, SensorsConfigurationError, SensorsManager
 from easynav.system.sensors.handlers import LaserScanHandler
 

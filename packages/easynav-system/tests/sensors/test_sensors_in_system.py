@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from sensor_test_helpers import make_scan
 
-from easynav.core.sensors import PointPerception
+from easynav.common.sensors import PointPerception
 from easynav.core.types import DiagnosticLevel
 from easynav.system.testing.system_fixtures import system_params, wait_for
 

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from sensor_test_helpers import make_cloud, make_imu, make_scan
 
-from easynav.core.nav_state import NavState
-from easynav.core.plugins import DictParameters
-from easynav.core.sensors import (
+from easynav.common.sensors import (
     ImuPerception,
     PointPerception,
 )
+from easynav.core.nav_state import NavState
+from easynav.core.plugins import DictParameters
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus
 from easynav.system.sensors import PerceptionHandler, SensorsConfigurationError, SensorsManager
 from easynav.system.sensors.handlers import LaserScanHandler
@@ -145,7 +145,7 @@ def test_a_sensor_that_dies_stops_being_used():
     stale = nav_state.get("laser1", PointPerception)
     assert not stale.valid and not stale.new_data
     assert held.valid, "perceptions are replaced, never mutated under a reader"
-    from easynav.core.sensors import PointPerceptionsOps
+    from easynav.common.sensors import PointPerceptionsOps
 
     assert PointPerceptionsOps(nav_state.get_no_group(PointPerception)).as_points().shape == (0, 3)
 

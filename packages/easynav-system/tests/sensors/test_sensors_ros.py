@@ -18,8 +18,7 @@ from sensor_test_helpers import (
     make_scan,
 )
 
-from easynav.core.nav_state import NavState
-from easynav.core.sensors import (
+from easynav.common.sensors import (
     DetectionsPerception,
     GNSSPerception,
     ImagePerception,
@@ -27,7 +26,8 @@ from easynav.core.sensors import (
     OdometryPerception,
     PointPerception,
 )
-from easynav.core.tf import TFBuffer, TFInfo
+from easynav.common.tf import TFBuffer, TFInfo
+from easynav.core.nav_state import NavState
 from easynav.system.node_parameters import NodeParameters
 from easynav.system.sensors import SensorsConfigurationError, SensorsManager
 from easynav.system.sensors.converters import points_from_point_cloud2

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from easynav.core.sensors import PointPerception
+from easynav.common.sensors import PointPerception
 from easynav.core.types import Header, Twist, TwistStamped
 from easynav.system.testing.system_fixtures import system_params
 

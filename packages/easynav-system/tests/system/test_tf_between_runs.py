@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from easynav.core.tf import get_tf_buffer
+from easynav.common.tf import get_tf_buffer
 from easynav.core.types import Header, Transform, TransformStamped
 from easynav.system.testing.system_fixtures import system_params
 

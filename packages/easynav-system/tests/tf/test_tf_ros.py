@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from easynav.core.tf import TFBuffer
+from easynav.common.tf import TFBuffer
 from easynav.core.types import Header, Transform, TransformStamped
 from easynav.system.tf import StaticTFBroadcaster, TFBroadcaster, TFListener
 

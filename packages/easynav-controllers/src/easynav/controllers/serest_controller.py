@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import get_tf_buffer
 from easynav.controllers.controller_keys import (
     CLOSEST_OBSTACLE_DISTANCE,
     GOAL_TOLERANCE_POSITION,
@@ -17,8 +19,6 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, PATH, ROBOT_POSE
 from easynav.core.plugins import ControllerMethodBase, Param
 from easynav.core.robot import RobotLimits
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Odometry, Path, Twist, TwistStamped
 
 _GE0 = {"ge": 0.0}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from easynav.common.tf import get_tf_buffer
 from easynav.controllers.path_follower import SimplePathFollower
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import (
@@ -15,7 +16,6 @@ from easynav.core.nav_state_keys import (
 )
 from easynav.core.plugins import ControllerMethodBase, Param, PluginConfigurationError
 from easynav.core.robot import RobotLimits
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
 
 #: The follower's parameters (with the defaults of the original EasyNav's SimpleController,

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import get_tf_buffer
 from easynav.controllers.command_limits import limit_command
 from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW
 from easynav.controllers.path_follower import carrot_on_path
@@ -14,8 +16,6 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, GOALS, PATH, ROBOT_POSE
 from easynav.core.plugins import ControllerMethodBase, Param
 from easynav.core.robot import RobotLimits
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Goals, Header, Odometry, Path, Twist, TwistStamped
 
 #: States reported in ``self.state``.

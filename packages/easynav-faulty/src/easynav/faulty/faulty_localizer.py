@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE
 from easynav.core.plugins import LocalizerMethodBase, Param
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Pose
 from easynav.faulty.fault_injector import FaultInjector
 

@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import GOALS, PATH, ROBOT_POSE
 from easynav.core.plugins import PlannerMethodBase
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Goals, Header, Odometry, Path, Pose
 from easynav.faulty.fault_injector import FaultInjector
 

@@ -7,12 +7,11 @@ import threading
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import MAP_BASE, ROBOT_POSE, NavStateKey
 from easynav.core.plugins import LocalizerMethodBase, Param, Topic
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
     Header,
     Odometry,
@@ -23,6 +22,7 @@ from easynav.core.types import (
     normalize_angle,
     yaw_to_quaternion,
 )
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.localizers.particle_filter import (
     ParticleFilter2D,
     compiled_scoring_pays,

@@ -7,11 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE, NavStateKey
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Odometry, Pose
 from easynav.localizers.amcl_localizer import MIN_POINT_Z, AMCLLocalizer
 from easynav.localizers.costmap_sampling import (

@@ -9,19 +9,19 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from easynav.common.sensors import GNSSPerception, ImuPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE, NavStateKey
 from easynav.core.plugins import LocalizerMethodBase, Param, PluginConfigurationError, Topic
 from easynav.core.plugins.declarations import ParameterValueError
-from easynav.core.sensors import GNSSPerception, ImuPerception
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
     Header,
     Odometry,
     Pose,
     Twist,
 )
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.localizers.fusion.fusion_filter import FusionFilter, quaternion_to_rpy
 from easynav.localizers.fusion.fusion_parameters import (
     FILTER_PARAMETERS,

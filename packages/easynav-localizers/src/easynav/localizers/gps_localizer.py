@@ -7,12 +7,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from easynav.common.sensors import GNSSPerception, ImuPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE
 from easynav.core.plugins import LocalizerMethodBase, Param, Topic
-from easynav.core.sensors import GNSSPerception, ImuPerception
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
     Header,
     Odometry,
@@ -21,6 +20,7 @@ from easynav.core.types import (
     TransformStamped,
     Twist,
 )
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.localizers.gps.gps_pose_estimator import GpsPoseEstimator
 
 #: The original's fixed topics (relative; not parameters, not through the sensors node).

@@ -10,19 +10,19 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from easynav.common.sensors import GNSSPerception, ImuPerception
+from easynav.common.sensors.gnss_perception import COVARIANCE_TYPE_DIAGONAL_KNOWN
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE
 from easynav.core.plugins import LocalizerMethodBase, Param, Topic
-from easynav.core.sensors import GNSSPerception, ImuPerception
-from easynav.core.sensors.gnss_perception import COVARIANCE_TYPE_DIAGONAL_KNOWN
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
     Header,
     Odometry,
     Pose,
     quaternion_to_yaw,
 )
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.localizers.fusion_localizer import GNSS_GROUP
 from easynav.localizers.map_to_odom import map_to_odom
 

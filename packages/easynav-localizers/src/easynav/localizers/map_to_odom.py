@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from easynav.core.tf import TFBuffer
+from easynav.common.tf import TFBuffer
 from easynav.core.types import (
     Header,
     Transform,

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import NavStateKey
 from easynav.core.plugins import Param, PluginConfigurationError
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, normalize_angle
 from easynav.localizers.amcl_localizer import odometry_increment
 from easynav.localizers.costmap_amcl_localizer import (

@@ -9,12 +9,12 @@ from dataclasses import replace
 
 import numpy as np
 
+from easynav.common.sensors import ImuPerception, PointPerception, PointPerceptionsOps
+from easynav.common.sensors.point_perceptions_ops import transform_points
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE, NavStateKey
 from easynav.core.plugins import Param
-from easynav.core.sensors import ImuPerception, PointPerception, PointPerceptionsOps
-from easynav.core.sensors.point_perceptions_ops import transform_points
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import (
     Header,
     Odometry,

@@ -8,13 +8,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import MAP, MAP_BASE, MAP_TIME
 from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError, Topic
 from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.map_file_resolver import resolve_map_file
 from easynav.maps.map_format_error import MapFormatError
 from easynav.maps.occupancy_grid import OccupancyGrid

@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import math
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import DIAGNOSTICS_PATH, GOALS, PATH, ROBOT_POSE
 from easynav.core.plugins import PlannerMethodBase, Topic
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Goals, Header, Odometry, Path
+from easynav.core.warning_throttle import WarningThrottle
 
 #: The planners' diagnostic: NavState ``diagnostics.path`` (hardware id ``planner``).
 DIAGNOSTIC_NAME = "path"

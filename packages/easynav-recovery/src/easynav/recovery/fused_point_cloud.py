@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps, voxel_downsample_indices
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
-from easynav.core.sensors import PointPerception, PointPerceptionsOps, voxel_downsample_indices
-from easynav.core.tf import get_tf_buffer
 
 
 class FusedPointCloud:

@@ -276,6 +276,7 @@ class ComponentNode(LifecycleNode):
             logger=self.get_logger(),
             robot_geometry=self.system.robot_geometry,
             robot_limits=self.system.robot_limits,
+            tf_info=self.system.services.tf_info,
             services=self.system.services.plugin_services(),
             rt_node=self.system.rt_node,
             frequencies_in_use=self.system.frequencies_in_use,

@@ -20,6 +20,7 @@ from rclpy.qos import (
     QoSReliabilityPolicy,
 )
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.diagnostics import write_diagnostic
 from easynav.core.nav_state_keys import (
     CMD_VEL,
@@ -33,7 +34,6 @@ from easynav.core.nav_state_keys import (
 from easynav.core.plugins.declarations import ParameterValueError
 from easynav.core.plugins.plugin_kinds import CONTROLLER
 from easynav.core.robot import DEFAULT_ROBOT_LIMITS, RobotLimits
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
 from easynav.core.types import Header, SafetyChannelState, Twist, TwistStamped
 from easynav.core.velocity import VelocityOutput, limits_in_force
 from easynav.system.colision_checker import SEARCH_RANGE, ColisionChecker

@@ -8,7 +8,7 @@ from easynav.system.sensors import SensorsManager
 
 class SensorsNode(ComponentNode):
     """sensors_node: ``forget_time``, ``sensors`` and per sensor ``topic``, ``type``, ``group``,
-    ``plugin`` (see easynav.core.sensors). Its subscriptions are spun by the RT loop.
+    ``plugin`` (see easynav.common.sensors). Its subscriptions are spun by the RT loop.
 
     Thread contract: ``cycle_rt`` in the RT thread (also the sensor callbacks), ``cycle`` in the
     non-RT thread.

@@ -6,10 +6,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from easynav.common.tf import TFInfo
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginServices, RecoveryActions
 from easynav.core.robot import RobotGeometry, RobotLimits
-from easynav.core.tf import TFInfo
 from easynav.system.system_requests import ParameterChange, SystemRequests
 
 if TYPE_CHECKING:

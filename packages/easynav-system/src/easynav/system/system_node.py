@@ -11,10 +11,10 @@ from rclpy.node import Node
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import String
 
+from easynav.common.tf import TFInfo, get_tf_buffer
 from easynav.core.plugins.compatibility import compatibility_errors
 from easynav.core.plugins.declarations import ParameterValueError, read_parameters
 from easynav.core.robot import RobotGeometry, RobotGeometryRegistry
-from easynav.core.tf import TFInfo, get_tf_buffer
 from easynav.system.component_node import ComponentNode
 from easynav.system.controller_node import ControllerNode
 from easynav.system.goal_manager_extension import GoalManagerExtension

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from easynav.common.tf import get_tf_buffer
 from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW, MAP
 from easynav.controllers.legacy_limits import capped_limits, warn_set_caps
 from easynav.controllers.regulated_pp.regulated_pure_pursuit import (
@@ -19,7 +20,6 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, NAVIGATION_STATE, PATH, ROBOT_POSE
 from easynav.core.plugins import ControllerMethodBase, Topic
 from easynav.core.robot import RobotLimits
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D, Header, Odometry, Path, Twist, TwistStamped
 
 #: Seconds assumed since the previous cycle on the first one or after a pause (the original's).

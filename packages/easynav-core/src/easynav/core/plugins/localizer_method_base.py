@@ -7,7 +7,6 @@ import numpy as np
 from easynav.core.nav_state import NavState
 from easynav.core.plugins.declarations import Topic
 from easynav.core.plugins.method_base import MethodBase
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Header, Odometry, Pose
 
 #: Topic every localizer listens to for a pose to reset to (as in the original EasyNav), relative.
@@ -73,7 +72,7 @@ class LocalizerMethodBase(MethodBase):
         :meth:`on_initial_pose` are logged, not raised (they would end the executor's spin).
         """
         alias = self.plugin_name
-        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        tf_info = self.get_tf_info()
         map_frame = tf_info.map_frame
         if frame and frame.lstrip("/") != map_frame:
             self.logger.warning(

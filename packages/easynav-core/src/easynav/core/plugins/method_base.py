@@ -9,7 +9,7 @@ from easynav.core.plugins.parameter_owner import ParameterOwner
 from easynav.core.plugins.plugin_context import PluginContext
 from easynav.core.plugins.rate_monitor import RateMonitor
 from easynav.core.plugins.rate_schedule import RateSchedule
-from easynav.core.robot import RobotGeometry
+from easynav.core.robot import RobotGeometry, TFInfo
 
 
 class PluginConfigurationError(RuntimeError):
@@ -175,6 +175,10 @@ class MethodBase(ParameterOwner):
     def get_robot_geometry(self) -> RobotGeometry:
         """The robot geometry configured in system_node (snapshot)."""
         return self.context.robot_geometry()
+
+    def get_tf_info(self) -> TFInfo:
+        """The robot's frames configured in system_node (snapshot)."""
+        return self.context.tf_info()
 
     def now(self) -> float:
         """The host node's clock, in seconds."""

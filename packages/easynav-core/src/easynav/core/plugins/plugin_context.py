@@ -8,7 +8,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from easynav.core.robot import RobotGeometry, RobotLimits
+from easynav.core.robot import RobotGeometry, RobotLimits, TFInfo
 
 if TYPE_CHECKING:
     from easynav.core.plugins.recovery_manager_base import RecoveryActions
@@ -93,6 +93,8 @@ class PluginContext:
     unit tests): plugins create their debug publishers and subscriptions on it.
     ``now`` returns the node clock in seconds (simulated time with ``use_sim_time``).
     ``robot_limits`` returns the limits in force (cut down by a safely limited speed).
+    ``robot_geometry`` and ``tf_info`` return the robot's shape and frames as system_node
+    configured them (the defaults without a host).
     ``rt_node`` is a node spun by the RT loop's executor (None without ROS): subscriptions whose
     data the RT part needs at once (odometry for a prediction) go there, so a slow non-RT loop
     cannot delay them; their callbacks run in the RT thread and must only store the data.
@@ -111,6 +113,7 @@ class PluginContext:
     logger: Any = field(default_factory=lambda: logging.getLogger("easynav"))
     robot_geometry: Callable[[], RobotGeometry] = RobotGeometry
     robot_limits: Callable[[], RobotLimits] = RobotLimits
+    tf_info: Callable[[], TFInfo] = TFInfo
     services: PluginServices = field(default_factory=PluginServices)
     rt_node: Any = None
     frequencies_in_use: set[tuple[str, str]] | None = None

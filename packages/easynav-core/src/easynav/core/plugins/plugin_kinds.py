@@ -32,7 +32,7 @@ MAPS_MANAGER = PluginKind(
 RECOVERY_MANAGER = PluginKind(
     "recovery manager", "easynav.recovery_managers", RecoveryManagerBase, "recovery_node"
 )
-# Perception handlers (sensors_node) derive from easynav.core.sensors.PerceptionHandler; their
+# Perception handlers (sensors_node) derive from easynav.system.sensors.PerceptionHandler; their
 # base lives with the sensors, the kind is listed here so discovery and `easynav plugins` see it.
 PERCEPTION_HANDLER = PluginKind(
     "perception handler", "easynav.perception_handlers", object, "sensors_node"

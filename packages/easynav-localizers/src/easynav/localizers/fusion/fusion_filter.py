@@ -7,8 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from easynav.core.sensors import GNSSPerception, ImuPerception
-from easynav.core.sensors.gnss_perception import COVARIANCE_TYPE_DIAGONAL_KNOWN
+from easynav.common.sensors import GNSSPerception, ImuPerception
+from easynav.common.sensors.gnss_perception import COVARIANCE_TYPE_DIAGONAL_KNOWN
 from easynav.core.types import Odometry
 from easynav.localizers.fusion.fusion_input import FusionInput
 from easynav.localizers.fusion.ukf_filter import (

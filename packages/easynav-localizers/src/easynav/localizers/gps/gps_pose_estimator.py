@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from easynav.core.sensors import GNSSPerception, ImuPerception
-from easynav.core.sensors.gnss_perception import COVARIANCE_TYPE_DIAGONAL_KNOWN
+from easynav.common.sensors import GNSSPerception, ImuPerception
+from easynav.common.sensors.gnss_perception import COVARIANCE_TYPE_DIAGONAL_KNOWN
 from easynav.localizers.fusion.fusion_filter import quaternion_to_rpy
 from easynav.localizers.fusion.utm_projection import UtmProjection
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.costmap.costmap_filter import COSTMAP_FILTER
 from easynav.maps.costmap.keys import MAP, MAP_BASE, MAP_OBSTACLE_BOUNDS, MAP_TIME
 from easynav.maps.costmap_io import (

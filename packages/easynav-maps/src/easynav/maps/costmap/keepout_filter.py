@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import LETHAL_OBSTACLE, NO_INFORMATION, Costmap2D
 from easynav.maps.costmap.costmap_filter import CostmapFilter
 from easynav.maps.costmap.filter_mask import FilterMask

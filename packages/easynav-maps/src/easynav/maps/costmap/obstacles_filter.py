@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import ExtrapolationError, TransformError, get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import ExtrapolationError, TransformError, get_tf_buffer
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.costmap.costmap_filter import CostmapFilter
 from easynav.maps.costmap.keys import MAP_OBSTACLE_BOUNDS, MAP_TIME
 from easynav.maps.ray_casting import NOT_MARKED, clear_along_rays

@@ -9,8 +9,8 @@ from typing import Any
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE
 from easynav.core.plugins import Param
-from easynav.core.sensors.warning_throttle import WarningThrottle
 from easynav.core.types import Costmap2D
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.costmap.costmap_filter import CostmapFilter
 from easynav.maps.costmap.filter_mask import FilterMask
 from easynav.maps.costmap.keepout_filter import load_filter_mask

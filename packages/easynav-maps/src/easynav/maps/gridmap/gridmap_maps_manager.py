@@ -6,7 +6,7 @@ import math
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import MapsManagerBase, Param, PluginConfigurationError
-from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.gridmap.grid_map import GridMap
 from easynav.maps.gridmap.gridmap_io import load_gridmap
 from easynav.maps.gridmap.keys import GRIDMAP

@@ -8,7 +8,7 @@ import numpy as np
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
-from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.navmap.navmap import (
     FREE_SPACE,
     INSCRIBED_INFLATED_OBSTACLE,

@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.navmap.navmap import FREE_SPACE, LETHAL_OBSTACLE, NavMap
 from easynav.maps.navmap.navmap_filter import NavMapFilter
 

@@ -6,11 +6,11 @@ from typing import Any
 
 import numpy as np
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, Topic
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Costmap2D
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.maps.costmap.keys import MAP
 from easynav.maps.costmap_io import costmap_to_occupancy_grid
 from easynav.maps.routes.routes_filter import RoutesFilter

@@ -5,10 +5,10 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
-from easynav.core.tf import get_tf_buffer
 from easynav.maps.filtered_maps_manager import FilteredMapsManager
 from easynav.maps.map_file_resolver import resolve_map_file
 from easynav.maps.map_format_error import MapFormatError

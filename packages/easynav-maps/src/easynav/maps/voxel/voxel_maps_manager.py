@@ -9,12 +9,12 @@ from typing import Any
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception, PointPerceptionsOps
+from easynav.common.sensors.point_perceptions_ops import transform_points
+from easynav.common.tf import TransformError, get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.plugins.plugin_endpoints import PluginEndpoints, latched_qos
-from easynav.core.sensors import PointPerception, PointPerceptionsOps
-from easynav.core.sensors.point_perceptions_ops import transform_points
-from easynav.core.tf import TransformError, get_tf_buffer
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
 from easynav.maps.costmap.costmap_maps_manager import CostmapMapsManager
 from easynav.maps.costmap.keys import MAP, MAP_BASE, MAP_OBSTACLE_BOUNDS, MAP_TIME

@@ -7,10 +7,10 @@ for driving a robot.
 
 from __future__ import annotations
 
+from easynav.common.sensors import PointPerception
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL
 from easynav.core.plugins import ControllerMethodBase, Param
-from easynav.core.sensors import PointPerception
 from easynav.core.types import Header, Twist, TwistStamped
 
 

@@ -8,11 +8,11 @@ import math
 
 import numpy as np
 
+from easynav.common.sensors import PointPerception
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, RecoveryManagerBase
 from easynav.core.robot import RobotGeometry
-from easynav.core.sensors import PointPerception
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticStatus, Odometry, Twist, TwistStamped
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.activation_aware_schedule import ActivationAwareSchedule

@@ -7,7 +7,7 @@ import logging
 from abc import ABC, abstractmethod
 from typing import Any, ClassVar
 
-from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.warning_throttle import WarningThrottle
 
 
 def normalize_type_name(type_name: str) -> str:

@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
+from easynav.common.sensors.point_perception import PointPerception
 from easynav.core.nav_state import NavState
-from easynav.core.sensors.point_perception import PointPerception
-from easynav.core.sensors.warning_throttle import WarningThrottle
+from easynav.core.warning_throttle import WarningThrottle
 from easynav.system.sensors.errors import PerceptionConversionError, SensorsConfigurationError
 from easynav.system.sensors.handler_registry import resolve_handler
 from easynav.system.sensors.handlers import LaserScanHandler, PointCloud2Handler

@@ -7,10 +7,10 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+from easynav.common.sensors.point_perception import PointPerception
+from easynav.common.sensors.point_perceptions_ops import PointPerceptionsOps
+from easynav.common.tf import TFBuffer, get_tf_buffer
 from easynav.core.nav_state import NavState
-from easynav.core.sensors.point_perception import PointPerception
-from easynav.core.sensors.point_perceptions_ops import PointPerceptionsOps
-from easynav.core.tf import TFBuffer, get_tf_buffer
 from easynav.system.sensors.errors import SensorsConfigurationError
 from easynav.system.sensors.fused_cloud_publisher import FusedCloudPublisher
 from easynav.system.sensors.sensor_channel import SensorChannel
@@ -77,7 +77,7 @@ class SensorsManager:
         without the node prefix). ``node`` None (tests, tools) subscribes and publishes nothing;
         feed messages with :meth:`handle_message`. ``clock`` returns ROS time in seconds
         (default: ``node``'s clock, simulated with ``use_sim_time``). ``tf_buffer`` defaults to
-        :func:`~easynav.core.tf.get_tf_buffer` of ``node``'s namespace (as system_node's).
+        :func:`~easynav.common.tf.get_tf_buffer` of ``node``'s namespace (as system_node's).
         Raises :class:`~easynav.system.sensors.errors.SensorsConfigurationError` naming the
         parameter, after undoing what was done (no subscription or key left behind).
         """

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from easynav.core.tf.transform_math import TransformTuple
+from easynav.common.tf.transform_math import TransformTuple
 from easynav.core.types import TransformStamped
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from easynav.core.tf.tf_buffer import TFBuffer
+from easynav.common.tf.tf_buffer import TFBuffer
 from easynav.core.types import TransformStamped
 from easynav.system.tf.ros_conversion import message_values, to_message
 

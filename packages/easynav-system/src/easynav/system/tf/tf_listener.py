@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from easynav.core.tf.tf_buffer import TFBuffer
-from easynav.core.tf.tf_buffer_registry import get_tf_buffer
+from easynav.common.tf.tf_buffer import TFBuffer
+from easynav.common.tf.tf_buffer_registry import get_tf_buffer
 from easynav.system.tf.ros_conversion import stamp_to_seconds
 
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import math
 
+from easynav.common.tf import TransformError, get_tf_buffer
 from easynav.core.diagnostics import read_diagnostics
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
-from easynav.core.tf import TransformError, get_tf_buffer
 from easynav.core.types import DiagnosticLevel, Odometry, TwistStamped
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.evaluator_base import EvaluatorBase

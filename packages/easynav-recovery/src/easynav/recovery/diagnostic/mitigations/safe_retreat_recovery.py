@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import math
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import DiagnosticLevel, DiagnosticStatus, Twist
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic import logging_levels

@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
+from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, Topic
-from easynav.core.tf import get_tf_buffer
 from easynav.core.types import Twist
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.diagnostic.safety_reflex_base import SafetyReflexBase

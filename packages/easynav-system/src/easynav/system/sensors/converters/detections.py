@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from easynav.core.sensors.detection import Detection
+from easynav.common.sensors.detection import Detection
 from easynav.core.types import Pose
 
 

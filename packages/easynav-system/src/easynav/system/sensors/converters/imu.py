@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from easynav.core.sensors.imu_perception import ImuPerception
+from easynav.common.sensors.imu_perception import ImuPerception
 from easynav.system.sensors.converters.stamps import header_stamp
 from easynav.system.sensors.errors import PerceptionConversionError
 

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from easynav.core.sensors.gnss_perception import STATUS_FIX, GNSSPerception
+from easynav.common.sensors.gnss_perception import STATUS_FIX, GNSSPerception
 from easynav.system.sensors.converters.stamps import header_stamp
 from easynav.system.sensors.errors import PerceptionConversionError
 

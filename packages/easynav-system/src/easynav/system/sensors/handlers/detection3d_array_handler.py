@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from easynav.core.sensors.detections_perception import DetectionsPerception
+from easynav.common.sensors.detections_perception import DetectionsPerception
 from easynav.system.sensors.converters.detections import detections_from_msg
 from easynav.system.sensors.converters.stamps import header_stamp
 from easynav.system.sensors.perception_handler import PerceptionHandler, import_message_class

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from easynav.core.sensors.image_perception import ImagePerception
+from easynav.common.sensors.image_perception import ImagePerception
 from easynav.system.sensors.converters.image import image_from_msg
 from easynav.system.sensors.converters.stamps import header_stamp
 from easynav.system.sensors.perception_handler import PerceptionHandler

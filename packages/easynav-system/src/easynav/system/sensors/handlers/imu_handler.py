@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from easynav.core.sensors.imu_perception import ImuPerception
+from easynav.common.sensors.imu_perception import ImuPerception
 from easynav.system.sensors.converters.imu import imu_from_msg
 from easynav.system.sensors.perception_handler import PerceptionHandler
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from easynav.core.sensors.point_perception import PointPerception
+from easynav.common.sensors.point_perception import PointPerception
 from easynav.system.sensors.converters.laser_scan import LaserScanConverter
 from easynav.system.sensors.converters.stamps import header_stamp
 from easynav.system.sensors.perception_handler import PerceptionHandler

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from easynav.core.sensors.gnss_perception import GNSSPerception
+from easynav.common.sensors.gnss_perception import GNSSPerception
 from easynav.system.sensors.converters.nav_sat_fix import gnss_from_msg
 from easynav.system.sensors.perception_handler import PerceptionHandler
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from easynav.core.sensors.odometry_perception import OdometryPerception
+from easynav.common.sensors.odometry_perception import OdometryPerception
 from easynav.system.sensors.errors import PerceptionConversionError
 from easynav.system.sensors.perception_handler import PerceptionHandler
 

@@ -6,7 +6,7 @@ import dataclasses
 
 import pytest
 
-from easynav.core.tf import (
+from easynav.common.tf import (
     TFInfo,
     get_tf_buffer,
     reset_tf_buffers,

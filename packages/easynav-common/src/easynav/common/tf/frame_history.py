@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from bisect import bisect_left
 
-from easynav.core.tf.transform_math import TransformTuple, interpolate
+from easynav.common.tf.transform_math import TransformTuple, interpolate
 
 
 class FrameHistory:

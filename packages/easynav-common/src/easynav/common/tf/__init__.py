@@ -5,19 +5,19 @@ plain Python and works without ROS: a script fills it with ``set_transform``. In
 system the runtime's listener (``easynav.system.tf``) fills it from ``tf``/``tf_static``.
 """
 
-from easynav.core.tf.errors import (
+from easynav.common.tf.errors import (
     ConnectivityError,
     ExtrapolationError,
     FrameLookupError,
     TransformError,
 )
-from easynav.core.tf.tf_buffer import TFBuffer
-from easynav.core.tf.tf_buffer_registry import (
+from easynav.common.tf.tf_buffer import TFBuffer
+from easynav.common.tf.tf_buffer_registry import (
     get_tf_buffer,
     reset_tf_buffers,
     set_default_tf_namespace,
 )
-from easynav.core.tf.tf_info import TFInfo
+from easynav.core.robot.tf_info import TFInfo
 
 __all__ = [
     "ConnectivityError",

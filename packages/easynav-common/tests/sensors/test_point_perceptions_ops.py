@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy.spatial.transform import Rotation
 
-from easynav.core.sensors import PointPerception, PointPerceptionsOps, voxel_downsample
-from easynav.core.tf import TFBuffer
+from easynav.common.sensors import PointPerception, PointPerceptionsOps, voxel_downsample
+from easynav.common.tf import TFBuffer
 
 NAN = math.nan
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import threading
 
-from easynav.core.tf.tf_buffer import TFBuffer
+from easynav.common.tf.tf_buffer import TFBuffer
 
 _lock = threading.Lock()
 _buffers: dict[str, TFBuffer] = {}

@@ -7,15 +7,15 @@ sensors manager (``easynav.system.sensors``) fills NavState with them from ROS t
 can make them directly from numpy arrays.
 """
 
-from easynav.core.sensors.detection import Detection
-from easynav.core.sensors.detections_perception import DetectionsPerception
-from easynav.core.sensors.gnss_perception import GNSSPerception
-from easynav.core.sensors.image_perception import ImagePerception
-from easynav.core.sensors.imu_perception import ImuPerception
-from easynav.core.sensors.odometry_perception import OdometryPerception
-from easynav.core.sensors.point_perception import PointPerception
-from easynav.core.sensors.point_perceptions_ops import PointPerceptionsOps
-from easynav.core.sensors.voxel_grid import voxel_downsample, voxel_downsample_indices
+from easynav.common.sensors.detection import Detection
+from easynav.common.sensors.detections_perception import DetectionsPerception
+from easynav.common.sensors.gnss_perception import GNSSPerception
+from easynav.common.sensors.image_perception import ImagePerception
+from easynav.common.sensors.imu_perception import ImuPerception
+from easynav.common.sensors.odometry_perception import OdometryPerception
+from easynav.common.sensors.point_perception import PointPerception
+from easynav.common.sensors.point_perceptions_ops import PointPerceptionsOps
+from easynav.common.sensors.voxel_grid import voxel_downsample, voxel_downsample_indices
 
 __all__ = [
     "Detection",

@@ -9,11 +9,11 @@ from typing import Any
 
 import numpy as np
 
-from easynav.core.sensors.point_perception import PointPerception
-from easynav.core.sensors.voxel_grid import voxel_downsample_indices
-from easynav.core.sensors.warning_throttle import WarningThrottle
-from easynav.core.tf import ExtrapolationError, TFBuffer, TransformError, get_tf_buffer
-from easynav.core.tf.transform_math import rotation_matrix
+from easynav.common.sensors.point_perception import PointPerception
+from easynav.common.sensors.voxel_grid import voxel_downsample_indices
+from easynav.common.tf import ExtrapolationError, TFBuffer, TransformError, get_tf_buffer
+from easynav.common.tf.transform_math import rotation_matrix
+from easynav.core.warning_throttle import WarningThrottle
 
 _LOGGER = logging.getLogger("easynav.sensors")
 _THROTTLE = WarningThrottle(period=5.0)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from easynav.core.sensors.detection import Detection
+from easynav.common.sensors.detection import Detection
 
 
 @dataclass(slots=True)

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation, Slerp
 from tf_test_helpers import matrix, stamped_matrix, yaw_values
 
-from easynav.core.tf import (
+from easynav.common.tf import (
     ConnectivityError,
     ExtrapolationError,
     FrameLookupError,

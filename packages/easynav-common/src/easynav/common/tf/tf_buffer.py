@@ -16,20 +16,20 @@ from typing import Any
 
 import numpy as np
 
-from easynav.core.tf.errors import (
+from easynav.common.tf.errors import (
     ConnectivityError,
     ExtrapolationError,
     FrameLookupError,
 )
-from easynav.core.tf.frame_history import FrameHistory
-from easynav.core.tf.tf_info import TFInfo
-from easynav.core.tf.transform_math import (
+from easynav.common.tf.frame_history import FrameHistory
+from easynav.common.tf.transform_math import (
     IDENTITY,
     TransformTuple,
     compose,
     inverse,
     normalized,
 )
+from easynav.core.robot.tf_info import TFInfo
 from easynav.core.types import Header, Transform, TransformStamped
 
 _MAX_DEPTH = 1000  # a tree deeper than this is a loop in the data, not a robot
