@@ -205,9 +205,7 @@ class ControllerNode(ComponentNode):
         robot_limits parameter too, so what is read back (and restored after a mitigation) is
         the limit in force."""
         for lp in self.plugins:
-            # A controller whose original named its limits otherwise lists them in
-            # DEPRECATED_LIMITS (MPC: max_linear_velocity; VFF: max_speed).
-            names = DEPRECATED_LIMIT_PARAMETERS | getattr(lp.plugin, "DEPRECATED_LIMITS", {})
+            names = DEPRECATED_LIMIT_PARAMETERS | dict(lp.plugin.DEPRECATED_LIMITS)
             for old, new in names.items():
                 old_name = f"{lp.alias}.{old}"
                 if not self.params.is_set(old_name) or old not in lp.plugin.params:
@@ -242,7 +240,8 @@ class ControllerNode(ComponentNode):
         )
         if self.keepalive_period > 0.0:
             # A receiver that requests a deadline learns when EasyNav stops commanding.
-            # MANUAL_BY_TOPIC: AUTOMATIC reports false losses in this rclpy (ENVIRONMENT.md).
+            # MANUAL_BY_TOPIC: with AUTOMATIC, rclpy (Jazzy) reports the liveliness "lost" when
+            # publisher and subscriber share a context, though messages flow.
             lease = Duration(seconds=2.0 * self.keepalive_period)
             qos.deadline = lease
             qos.liveliness = QoSLivelinessPolicy.MANUAL_BY_TOPIC

@@ -70,7 +70,8 @@ class EasyNavRuntime:
     - ``wait()``: blocks until a stop is requested (signal, recovery system, safety supervisor).
     - ``stop()``: controlled stop: deactivate (the controller brakes within the deceleration
       limits and its last command is an exact zero), shutdown to Finalized, executors down,
-      loop threads joined, then ``rclpy.shutdown`` — in that order (ENVIRONMENT.md).
+      loop threads joined, then ``rclpy.shutdown`` — in that order: ``rclpy.shutdown`` while an
+      executor still runs aborts the interpreter at exit (exit code 134).
 
     Thread contract: all public methods from the owner's (main) thread.
     """
@@ -128,8 +129,9 @@ class EasyNavRuntime:
 
     def start(self) -> bool:
         """Start the loops, then configure and activate. False (and ``error``) on failure."""
-        # A short GIL switch interval keeps the RT thread's jitter low (ENVIRONMENT.md:
-        # p99 5 ms → 0.1 ms with a CPU-bound thread in the process).
+        # A short GIL switch interval keeps the RT thread's jitter low: with a CPU-bound Python
+        # thread in the process, a waiting thread's wake-up measured p50 5 ms / p99 5.1 ms at
+        # the default 5 ms interval, 12 µs / 104 µs at 0.5 ms.
         sys.setswitchinterval(float(os.environ.get("EASYNAV_SWITCH_INTERVAL", "0.0005")))
         node = self.system_node
         node.trigger_configure()

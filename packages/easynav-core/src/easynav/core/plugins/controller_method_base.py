@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import ClassVar
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins.declarations import Param
@@ -39,6 +41,12 @@ class ControllerMethodBase(MethodBase):
               "deprecated: controller_node robot_limits.max_angular_acc", "rad/s²", ge=0.0,
               allow_nan=True, dynamic=False),
     )
+
+    #: Deprecated limits a controller's original named otherwise, beyond those four:
+    #: ``{parameter: RobotLimits field}`` (MPC: ``max_linear_velocity``; VFF: ``max_speed``).
+    #: controller_node applies them as it applies :attr:`DEPRECATED_PARAMETERS`; the controller
+    #: declares the parameters itself.
+    DEPRECATED_LIMITS: ClassVar[Mapping[str, str]] = {}
 
     def update_rt(self, nav_state: NavState) -> None:
         """Compute the command. RT thread. Exceptions are contained (the robot brakes)."""

@@ -46,7 +46,8 @@ class RosTestContext:
         return value
 
     def shutdown(self) -> None:
-        # Order matters (ENVIRONMENT.md): executor, nodes, then the context.
+        # Order matters: executor, nodes, then the context (the context shut down under a
+        # running executor aborts the interpreter at exit).
         self.executor.shutdown()
         for node in self.nodes:
             node.destroy_node()
