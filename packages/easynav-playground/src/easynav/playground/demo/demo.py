@@ -109,42 +109,14 @@ def run_demo(
     """
     out = stream or sys.stdout
     try:
-        description = WorldDescription.resolve(str(world))
-        if waypoints is None:
-            if description.waypoints_path is None:
-                raise DemoError(f"world {world!r} has no default waypoints: pass --waypoints")
-            waypoint_list = load_waypoints(description.waypoints_path)
-            waypoint_levels = load_waypoint_levels(description.waypoints_path)
-        elif isinstance(waypoints, str | Path):
-            waypoint_list = load_waypoints(waypoints)
-            waypoint_levels = load_waypoint_levels(waypoints)
-        else:
-            waypoint_list = [tuple(float(v) for v in w) for w in waypoints]
-            waypoint_levels = None
         if not (math.isfinite(speed_up) and speed_up > 0):
             raise DemoError(f"speed-up must be > 0, got {speed_up}")
+        description = WorldDescription.resolve(str(world))
+        waypoint_list, waypoint_levels = _waypoints_for(description, world, waypoints)
         params_path = Path(params_file) if params_file else DEFAULT_PARAMS
         run_path = Path(run_dir) if run_dir else Path(tempfile.mkdtemp(prefix="easynav_demo_"))
         run_path.mkdir(parents=True, exist_ok=True)
-        map_file = run_path / "world.map"
-        description.world.save_map_file(map_file)
-        robot = description.robot
-        derived = run_path / "params.yaml"
-        notes, path_topic = derive_params(
-            params_path,
-            map_file,
-            description.start_pose,
-            derived,
-            map_yaml=description.map_server_yaml(run_path),
-            robot_radius=robot.radius if robot.declared else None,
-            robot_height=robot.height,
-            terrain_file=(
-                description.terrain_path.resolve() if description.terrain_path else None
-            ),
-        )
-        notes = point_navmap_stack_at_world(
-            derived, description, description.map_server_yaml(run_path), notes
-        )
+        derived, notes, path_topic = _derive_run_params(description, params_path, run_path)
         costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
         scan_topics = laser_scan_topics(params_path)
         easynav = _easynav_command()
@@ -160,49 +132,14 @@ def run_demo(
     print(f"  params: {params_path}", file=out)
     for note in notes:
         print(f"  - {note}", file=out)
-    starts = [description.start_pose[:2]] + [w[:2] for w in waypoint_list[:-1]]
-    if costmap_planning:
-        # CostmapPlanner: cells of the map's own grid farther than the robot radius from walls.
-        check = {
-            "cell_size": description.world.resolution,
-            "robot_radius": description.robot.radius,
-            "clearance": 0.0,
-        }
-        rule = (
-            f"CostmapPlanner ({description.robot.radius:g} m robot on the "
-            f"{description.world.resolution:g} m map grid)"
-        )
-    else:
-        check = {}
-        rule = "SimplePlanner (0.3 m robot + 0.2 m clearance on a 0.2 m grid)"
-    if description.levels:
-        # The check walks the 2D map of one floor; the waypoints of a multi-level world lie on
-        # several floors joined by ramps, which it cannot follow.
-        print("  (multi-level world: the waypoints' reachability is not checked in 2D)", file=out)
-    else:
-        for i, (start, w) in enumerate(zip(starts, waypoint_list, strict=True), 1):
-            if not reachable_from(description.world, start, [w[:2]], **check)[0]:
-                print(
-                    f"  warning: waypoint {i} ({w[0]:.2f}, {w[1]:.2f}) looks unreachable from "
-                    f"({start[0]:.2f}, {start[1]:.2f}) for {rule}",
-                    file=out,
-                )
+    _warn_unreachable_waypoints(description, waypoint_list, costmap_planning, out)
     reservation = _domain_for_run(domain_id)
     domain = reservation.domain if reservation is not None else int(domain_id)
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
     record = run_path / "ground_truth.json"
     playground_argv = [
-        sys.executable,
-        "-m",
-        "easynav.playground",
-        "--world",
-        str(world),
-        "--speed-up",
-        str(speed_up),
-        "--seed",
-        str(seed),
-        "--record",
-        str(record),
+        sys.executable, "-m", "easynav.playground", "--world", str(world),
+        "--speed-up", str(speed_up), "--seed", str(seed), "--record", str(record),
     ]
     if not moving_obstacles:
         playground_argv.append("--no-obstacles")
@@ -224,6 +161,77 @@ def run_demo(
         if reservation is not None:
             reservation.release()
         print(f"  logs: {run_path}", file=out)
+
+
+def _waypoints_for(description: WorldDescription, world: str, waypoints):
+    """``(waypoints, levels)``: the given list or YAML file, else the world's own; ``levels``
+    (the floor of each waypoint) only from a YAML file that has them."""
+    if waypoints is None:
+        if description.waypoints_path is None:
+            raise DemoError(f"world {world!r} has no default waypoints: pass --waypoints")
+        waypoints = description.waypoints_path
+    if isinstance(waypoints, str | Path):
+        return load_waypoints(waypoints), load_waypoint_levels(waypoints)
+    return [tuple(float(v) for v in w) for w in waypoints], None
+
+
+def _derive_run_params(description: WorldDescription, params_path: Path, run_path: Path):
+    """The params file pointed at the world, written to ``run_path/params.yaml``: the map (the
+    world saved as a ``.map``, and as a map-server YAML for the costmap stack), the start pose,
+    the robot's size and terrain, and the NavMap stack's files. Returns ``(derived params
+    path, notes saying what was changed, the planner's path topic)``."""
+    map_file = run_path / "world.map"
+    description.world.save_map_file(map_file)
+    robot = description.robot
+    derived = run_path / "params.yaml"
+    notes, path_topic = derive_params(
+        params_path,
+        map_file,
+        description.start_pose,
+        derived,
+        map_yaml=description.map_server_yaml(run_path),
+        robot_radius=robot.radius if robot.declared else None,
+        robot_height=robot.height,
+        terrain_file=description.terrain_path.resolve() if description.terrain_path else None,
+    )
+    notes = point_navmap_stack_at_world(
+        derived, description, description.map_server_yaml(run_path), notes
+    )
+    return derived, notes, path_topic
+
+
+def _warn_unreachable_waypoints(description: WorldDescription, waypoint_list,
+                                costmap_planning: bool, out: TextIO) -> None:
+    """Print a warning for each waypoint that looks unreachable from the one before (from the
+    start for the first), by the rule of the planner (CostmapPlanner or SimplePlanner). The
+    mission still runs: the check is a coarse grid search, the planner decides."""
+    if description.levels:
+        # The check walks the 2D map of one floor; the waypoints of a multi-level world lie on
+        # several floors joined by ramps, which it cannot follow.
+        print("  (multi-level world: the waypoints' reachability is not checked in 2D)", file=out)
+        return
+    if costmap_planning:
+        # CostmapPlanner: cells of the map's own grid farther than the robot radius from walls.
+        check = {
+            "cell_size": description.world.resolution,
+            "robot_radius": description.robot.radius,
+            "clearance": 0.0,
+        }
+        rule = (
+            f"CostmapPlanner ({description.robot.radius:g} m robot on the "
+            f"{description.world.resolution:g} m map grid)"
+        )
+    else:
+        check = {}
+        rule = "SimplePlanner (0.3 m robot + 0.2 m clearance on a 0.2 m grid)"
+    starts = [description.start_pose[:2]] + [w[:2] for w in waypoint_list[:-1]]
+    for i, (start, w) in enumerate(zip(starts, waypoint_list, strict=True), 1):
+        if not reachable_from(description.world, start, [w[:2]], **check)[0]:
+            print(
+                f"  warning: waypoint {i} ({w[0]:.2f}, {w[1]:.2f}) looks unreachable from "
+                f"({start[0]:.2f}, {start[1]:.2f}) for {rule}",
+                file=out,
+            )
 
 
 def build_parser() -> argparse.ArgumentParser:
