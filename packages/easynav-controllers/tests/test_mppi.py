@@ -165,7 +165,8 @@ def make_batch(vx, wz, pose=(0.0, 0.0, 0.0), path=None, costmap=None, goal=(5.0,
     wz = np.asarray(wz, dtype=np.float32)
     x, y, yaw = constrain_and_integrate_reference(
         vx, wz, pose, (0.0, 0.0), 0.1, (-1.0, 1.0, 2.0, math.inf, math.inf, math.inf, math.inf))
-    path = straight_path(5.0, 0.1) if path is None else path
+    # The path ends at the goal (on the x axis): the critics measure "near the goal" along it.
+    path = straight_path(goal[0], 0.1) if path is None else path
     s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path[:, :2], axis=0).T))))
     return MppiBatch(vx, wz, x, y, yaw, np.zeros(len(vx), dtype=np.float32), 0.1, pose,
                      (0.0, 0.0), LIMITS, path[:, :2], path[:, 2], s, True, goal,
@@ -398,3 +399,37 @@ def test_brakes_when_every_candidate_collides():
     assert command.state == "blocked"
     assert command.v == pytest.approx(0.4 - 1.0 * 0.05) and command.w == 0.0
     assert not optimizer.sequence.any()
+
+
+def u_turn_path(step=0.05):
+    """East 1 m, north 0.6 m, west 1 m: the goal (0, 0.6) is 0.6 m from the start in a straight
+    line and 2.6 m along the path."""
+    east = np.column_stack((np.arange(0.0, 1.0, step), np.zeros(20)))
+    north = np.column_stack((np.full(12, 1.0), np.arange(0.0, 0.6, step)))
+    west = np.column_stack((np.arange(1.0, -1e-9, -step), np.full(21, 0.6)))
+    xy = np.vstack((east, north, west))
+    yaw = np.arctan2(np.diff(xy[:, 1], append=xy[-1, 1]), np.diff(xy[:, 0], append=xy[-1, 0]))
+    return np.column_stack((xy, yaw))
+
+
+def test_near_the_goal_is_measured_along_the_path():
+    # A goal 0.6 m away in a straight line but 2.6 m along the path (round an obstacle): the
+    # path critics still apply and the goal critics do not (the goal critic pulled the robot
+    # straight at the obstacle between the tb3_sandbox pillars).
+    vx = [[0.5] * 10, [0.3] * 10]
+    wz = [[0.0] * 10, [0.4] * 10]
+    batch = make_batch(vx, wz, path=u_turn_path(), goal=(0.0, 0.6, math.pi))
+    assert batch.goal_dist == pytest.approx(0.6)
+    assert batch.remaining == pytest.approx(2.6, abs=1e-6)
+    assert not critic_values("GoalCritic", batch).any()
+    assert not critic_values("GoalAngleCritic", batch).any()
+    assert critic_values("PathFollowCritic", batch).all()
+    # Along a path that ends within the threshold, the goal critic takes over.
+    near = make_batch(vx, wz, goal=(1.0, 0.0, 0.0))
+    assert near.remaining == pytest.approx(1.0)
+    assert critic_values("GoalCritic", near).all()
+    assert not critic_values("PathFollowCritic", near).any()
+    # The local path does not reach the goal: not near.
+    far = make_batch(vx, wz)
+    far.path_is_final = False
+    assert far.remaining == math.inf

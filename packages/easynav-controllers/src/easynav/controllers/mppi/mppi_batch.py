@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,8 +21,9 @@ class MppiBatch:
     (``path_xy`` P×2, ``path_yaw`` P, ``path_s`` P arc length from the robot's projection) starts
     at the robot's projection on the global path; ``path_is_final`` says whether it ends at the
     goal. ``goal`` is (x, y, yaw) of the last path pose, ``goal_dist`` the robot's straight
-    distance to it. ``costmap`` is None when NavState has no ``map``; ``collision`` is the cycle's
-    collision test over it (None: the CostCritic tests the cells under the poses only).
+    distance to it (:attr:`remaining`: along the path). ``costmap`` is None when NavState has
+    no ``map``; ``collision`` is the cycle's collision test over it (None: the CostCritic tests
+    the cells under the poses only).
 
     Thread contract: built and scored in the RT thread; never shared.
     """
@@ -45,6 +47,23 @@ class MppiBatch:
     costmap: Costmap2D | None = None
     collision: CollisionModel | None = None
     _furthest: int | None = field(default=None, repr=False)
+
+    @property
+    def remaining(self) -> float:
+        """Length (m) of the path left from the robot's projection on it to the goal; ``inf``
+        when the local path does not reach the goal.
+
+        What the critics' "near the goal" thresholds (``threshold_to_consider``,
+        ``near_goal_distance``) compare with, as Nav2 does since 2025 (it used the straight
+        distance): where the path goes round an obstacle to a goal just behind it, the goal is
+        near in a straight line but not along the path, and the goal critic, taking over from
+        the path critics, pulled the robot straight at the obstacle (seen between the
+        tb3_sandbox pillars: the robot crept along a pillar towards a goal 1.4 m away beyond
+        it).
+        """
+        if not self.path_is_final or len(self.path_s) == 0:
+            return math.inf
+        return float(self.path_s[-1])
 
     @property
     def samples(self) -> int:

@@ -29,7 +29,7 @@ class CostCritic(Critic):
     DEFAULT_WEIGHT = 3.81
     PARAMETERS = (
         Param("collision_cost", 1000000.0, "added to a colliding rollout (unweighted)", ge=0.0),
-        Param("near_goal_distance", 0.5, "no repulsive term within this distance of the goal",
+        Param("near_goal_distance", 0.5, "no repulsive term within this path length of the goal",
               "m", ge=0.0),
         Param("trajectory_point_step", 2, "score every n-th rollout pose", ge=1),
         Param("consider_unknown_lethal", True, "unknown cells (255) count as collisions"),
@@ -49,7 +49,7 @@ class CostCritic(Critic):
         lethal = collision.colliding(x, y, costs)
         collided = lethal.any(axis=1)
         batch.costs += np.float32(self.param("collision_cost")) * collided
-        if batch.path_is_final and batch.goal_dist < self.param("near_goal_distance"):
+        if batch.remaining < self.param("near_goal_distance"):
             return
         graded = np.where(lethal, 0, costs).sum(axis=1, dtype=np.float32)
         # Costs normalised to [0, 1] (÷ 254, as Nav2) so the weight is comparable with the

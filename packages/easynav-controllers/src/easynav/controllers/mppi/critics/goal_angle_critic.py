@@ -16,11 +16,11 @@ class GoalAngleCritic(Critic):
     NAME = "GoalAngleCritic"
     DEFAULT_WEIGHT = 3.0
     PARAMETERS = (
-        Param("threshold_to_consider", 0.5, "applies within this distance of the goal", "m",
+        Param("threshold_to_consider", 0.5, "applies within this path length of the goal", "m",
               ge=0.0),
     )
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:
-        if not batch.path_is_final or batch.goal_dist > self.param("threshold_to_consider"):
+        if batch.remaining > self.param("threshold_to_consider"):
             return None
         return np.abs(wrap_angle(batch.yaw - np.float32(batch.goal[2]))).mean(axis=1)

@@ -16,12 +16,12 @@ class GoalCritic(Critic):
     NAME = "GoalCritic"
     DEFAULT_WEIGHT = 5.0
     PARAMETERS = (
-        Param("threshold_to_consider", 1.4, "applies within this distance of the goal", "m",
+        Param("threshold_to_consider", 1.4, "applies within this path length of the goal", "m",
               ge=0.0),
     )
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:
-        if not batch.path_is_final or batch.goal_dist > self.param("threshold_to_consider"):
+        if batch.remaining > self.param("threshold_to_consider"):
             return None
         gx, gy, _ = batch.goal
         return np.hypot(batch.x - gx, batch.y - gy).mean(axis=1)

@@ -27,7 +27,7 @@ class PathAlignCritic(Critic):
     PARAMETERS = (
         Param("offset_from_furthest", 20, "path points that must be reached to apply", ge=0),
         Param("trajectory_point_step", 4, "score every n-th rollout pose", ge=1),
-        Param("threshold_to_consider", 0.5, "does not apply within this distance of the goal",
+        Param("threshold_to_consider", 0.5, "does not apply within this path length of the goal",
               "m", ge=0.0),
         Param("max_path_occupancy_ratio", 0.07, "blocked-path fraction above which to skip",
               ge=0.0, le=1.0),
@@ -35,7 +35,7 @@ class PathAlignCritic(Critic):
     )
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:
-        if batch.path_is_final and batch.goal_dist < self.param("threshold_to_consider"):
+        if batch.remaining < self.param("threshold_to_consider"):
             return None
         furthest = batch.furthest_reached_index()
         if furthest < self.param("offset_from_furthest") or furthest < 1:

@@ -24,7 +24,7 @@ class PathAngleCritic(Critic):
     DEFAULT_WEIGHT = 2.2
     PARAMETERS = (
         Param("offset_from_furthest", 4, "path points beyond the furthest reached", ge=0),
-        Param("threshold_to_consider", 0.5, "does not apply within this distance of the goal",
+        Param("threshold_to_consider", 0.5, "does not apply within this path length of the goal",
               "m", ge=0.0),
         Param("max_angle_to_furthest", 0.785, "applies when the robot's angle exceeds it", "rad",
               ge=0.0),
@@ -33,7 +33,7 @@ class PathAngleCritic(Critic):
     )
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:
-        if batch.path_is_final and batch.goal_dist < self.param("threshold_to_consider"):
+        if batch.remaining < self.param("threshold_to_consider"):
             return None
         if len(batch.path_xy) < 2:
             return None

@@ -17,12 +17,12 @@ class PathFollowCritic(Critic):
     DEFAULT_WEIGHT = 5.0
     PARAMETERS = (
         Param("offset_from_furthest", 5, "path points beyond the furthest reached", ge=0),
-        Param("threshold_to_consider", 1.4, "does not apply within this distance of the goal",
+        Param("threshold_to_consider", 1.4, "does not apply within this path length of the goal",
               "m", ge=0.0),
     )
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:
-        if batch.path_is_final and batch.goal_dist < self.param("threshold_to_consider"):
+        if batch.remaining < self.param("threshold_to_consider"):
             return None
         if len(batch.path_xy) < 2:
             return None

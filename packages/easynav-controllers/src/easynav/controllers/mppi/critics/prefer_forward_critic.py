@@ -16,11 +16,11 @@ class PreferForwardCritic(Critic):
     NAME = "PreferForwardCritic"
     DEFAULT_WEIGHT = 5.0
     PARAMETERS = (
-        Param("threshold_to_consider", 0.5, "does not apply within this distance of the goal",
+        Param("threshold_to_consider", 0.5, "does not apply within this path length of the goal",
               "m", ge=0.0),
     )
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:
-        if batch.path_is_final and batch.goal_dist < self.param("threshold_to_consider"):
+        if batch.remaining < self.param("threshold_to_consider"):
             return None
         return np.maximum(-batch.vx, 0.0).sum(axis=1) * batch.dt
