@@ -229,11 +229,7 @@ class CollisionModel:
                   costs: np.ndarray | None = None) -> np.ndarray:
         """Boolean array (the shape of ``x``): which poses collide. ``costs``: the cells'
         values at the poses when already looked up (:func:`rollout_costs`)."""
-        if costs is None:
-            costs = rollout_costs(self.costmap, x, y)
-        hit = costs >= INSCRIBED_INFLATED_OBSTACLE
-        if not self.unknown_is_obstacle:
-            hit &= costs != NO_INFORMATION
+        hit = self._on_blocked_cells(x, y, costs)
         if self.field is not None and self.threshold > 0.0:
             hit |= self.field.below(x, y, self.threshold)
         return hit
@@ -241,11 +237,18 @@ class CollisionModel:
     def rollout_collides(self, x: np.ndarray, y: np.ndarray) -> bool:
         """Whether one rollout (1-D ``x``, ``y``) collides, with exact distances (the guard of
         the command: the critics' bilinear field may be off by up to half a cell diagonal)."""
-        costs = rollout_costs(self.costmap, x, y)
-        hit = costs >= INSCRIBED_INFLATED_OBSTACLE
-        if not self.unknown_is_obstacle:
-            hit &= costs != NO_INFORMATION
-        if hit.any():
+        if self._on_blocked_cells(x, y).any():
             return True
         return bool(self.field is not None and self.threshold > 0.0
                     and (self.field.exact(x, y) < self.threshold).any())
+
+    def _on_blocked_cells(self, x: np.ndarray, y: np.ndarray,
+                          costs: np.ndarray | None = None) -> np.ndarray:
+        """Which poses have their centre on an inscribed, lethal or (when it counts) unknown
+        cell, or off the map."""
+        if costs is None:
+            costs = rollout_costs(self.costmap, x, y)
+        hit = costs >= INSCRIBED_INFLATED_OBSTACLE
+        if not self.unknown_is_obstacle:
+            hit &= costs != NO_INFORMATION
+        return hit

@@ -157,10 +157,9 @@ class MppiOptimizer:
     and the new sequence is the softmin-weighted mean (temperature ``lambda``), Savitzky–Golay
     smoothed with the last applied commands and constrained again. Its first command is applied,
     unless its rollout collides (:class:`CollisionModel`: an inscribed or lethal cell, or an
-    obstacle within ``robot_radius`` + ``CostCritic.collision_margin``, or as near as the
-    path goes): then the best
-    sample's (state ``fallback``), and when that collides too the robot brakes (state
-    ``blocked``).
+    obstacle within ``robot_radius`` + ``CostCritic.collision_margin``, or as near as the path
+    goes): then the best sample's (state ``fallback``), and when that collides too the robot
+    brakes (state ``blocked``).
     Inside the goal's xy tolerance it rotates in place to the goal yaw and stops within the yaw
     tolerance.
 
@@ -279,8 +278,9 @@ class MppiOptimizer:
             return self._apply(0.0, w, ROTATING_TO_GOAL)
         self._at_goal_xy = False
 
-        reach = max(max_v, abs(limits.min_linear_vel)) * steps * dt + PATH_MARGIN
-        path_xy, path_yaw, path_s, is_final = self._local_path(np.array((x0, y0)), reach)
+        rollout_reach = max(max_v, abs(limits.min_linear_vel)) * steps * dt
+        path_xy, path_yaw, path_s, is_final = self._local_path(
+            np.array((x0, y0)), rollout_reach + PATH_MARGIN)
         if p["use_rotate_to_heading"]:
             ahead = min(int(np.searchsorted(path_s, p["rotate_to_heading_lookahead_dist"])),
                         len(path_xy) - 1)
@@ -315,9 +315,8 @@ class MppiOptimizer:
         sample_bounds = bounds[:3] + (math.inf,) * 4
         std = np.array((p["vx_std"], p["wz_std"]), dtype=np.float32)
         collision = None if costmap is None else CollisionModel(
-            costmap, pose, max(max_v, abs(limits.min_linear_vel)) * steps * dt, robot_radius,
-            p["CostCritic.collision_margin"], p["CostCritic.consider_unknown_lethal"], path_xy,
-            self._held)
+            costmap, pose, rollout_reach, robot_radius, p["CostCritic.collision_margin"],
+            p["CostCritic.consider_unknown_lethal"], path_xy, self._held)
         self._held = None if collision is None else collision.held
         batch = None
         for _ in range(p["iteration_count"]):
