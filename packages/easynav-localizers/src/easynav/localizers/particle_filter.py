@@ -138,11 +138,13 @@ def _compiled_scoring():
     global _SCORING
     if _SCORING is None:
         try:
+            from easynav.common.compiled_kernels import compile_in_child
             from easynav.localizers._scoring_numba import score_kernel
         except ImportError:
             _SCORING = False
         else:
-            _SCORING = score_kernel
+            _SCORING = compile_in_child(
+                score_kernel, "easynav.localizers._scoring_numba:score_kernel")
     return _SCORING or None
 
 

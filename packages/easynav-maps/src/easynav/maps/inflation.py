@@ -325,8 +325,12 @@ else:
     _column_distances = _jit(_column_distances)
     _row_bounded_search = _jit(_row_bounded_search)
     _row_envelope = _jit(_row_envelope)
-    _compiled_inflate = _jit(_inflate_kernel)
-    _compiled_distances = _jit(_squared_distances_kernel)
+    from easynav.common.compiled_kernels import compile_in_child
+
+    _compiled_inflate = compile_in_child(_jit(_inflate_kernel),
+                                         "easynav.maps.inflation:_compiled_inflate")
+    _compiled_distances = compile_in_child(_jit(_squared_distances_kernel),
+                                           "easynav.maps.inflation:_compiled_distances")
 
 
 def compiled() -> bool:

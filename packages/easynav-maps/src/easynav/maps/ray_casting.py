@@ -103,7 +103,10 @@ try:
 except ImportError:  # the optional extra is missing: the reference loop serves
     _compiled = None
 else:
-    _compiled = numba.njit(cache=True, nogil=True)(_clear_along_rays_kernel)
+    from easynav.common.compiled_kernels import compile_in_child
+
+    _compiled = compile_in_child(numba.njit(cache=True, nogil=True)(_clear_along_rays_kernel),
+                                 "easynav.maps.ray_casting:_compiled")
 
 
 def numba_available() -> bool:

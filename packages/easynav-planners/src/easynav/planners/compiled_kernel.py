@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import importlib
 
+from easynav.common.compiled_kernels import compile_in_child
+
 
 class CompiledKernel:
     """The function ``name`` of the module ``module`` (a numba ``@njit`` kernel), imported
@@ -23,7 +25,8 @@ class CompiledKernel:
         """The kernel, or None without numba."""
         if self._kernel is None:
             try:
-                self._kernel = getattr(importlib.import_module(self.module), self.name)
+                kernel = getattr(importlib.import_module(self.module), self.name)
+                self._kernel = compile_in_child(kernel, f"{self.module}:{self.name}")
             except ImportError:
                 self._kernel = False
         return self._kernel or None

@@ -91,8 +91,11 @@ def _compile():
         except ImportError:
             _compiled = False
         else:
-            _compiled = numba.njit(cache=True, nogil=True)(
-                _constrain_and_integrate_loop
+            from easynav.common.compiled_kernels import compile_in_child
+
+            _compiled = compile_in_child(
+                numba.njit(cache=True, nogil=True)(_constrain_and_integrate_loop),
+                "easynav.controllers.mppi.rollout:_compile",
             )
     return _compiled or None
 

@@ -182,7 +182,10 @@ try:
 except ImportError:  # the optional extra is missing: the reference loop serves
     _compiled = None
 else:
-    _compiled = numba.njit(cache=True, nogil=True)(_ray_keys_kernel)
+    from easynav.common.compiled_kernels import compile_in_child
+
+    _compiled = compile_in_child(numba.njit(cache=True, nogil=True)(_ray_keys_kernel),
+                                 "easynav.maps.voxel.voxel_rays:_compiled")
 
 
 def numba_available() -> bool:
@@ -236,7 +239,8 @@ def _free_keys_kernel(crossed, hits, table, out):  # pragma: no cover - compiled
 
 
 if _compiled is not None:
-    _compiled_free = numba.njit(cache=True, nogil=True)(_free_keys_kernel)
+    _compiled_free = compile_in_child(numba.njit(cache=True, nogil=True)(_free_keys_kernel),
+                                      "easynav.maps.voxel.voxel_rays:_compiled_free")
 
 
 def free_keys(crossed: np.ndarray, hits: np.ndarray) -> np.ndarray:

@@ -1,0 +1,132 @@
+"""Numba kernels compiled in a child process, so that a long-lived process only loads them.
+
+Compiling a numba kernel leaves LLVM's compile-time state behind in the process for good: the
+costmap stack with MPPI (ray casting, inflation, AMCL scoring, A*, MPPI's rollout) measured
+322 MB resident after a first run that compiled its kernels, 240 MB after a run that loaded
+them from numba's on-disk cache (``cache=True``), the same kernels doing the same work. The
+difference is live memory (``malloc_trim`` gives back 1 MB of it), so it cannot be freed once
+taken; it has to be taken elsewhere.
+
+:func:`compile_in_child` hooks a cached numba dispatcher so that a signature it has never seen
+is first looked up in numba's cache and, when absent, compiled by a short-lived child process
+(``python -m easynav.common.compiled_kernels``) that writes the cache; the process then loads
+it from there, as on every later run. Calls with known signatures pay nothing: the hook sits
+where numba's dispatcher goes only when no compiled version matches the arguments.
+
+The hook is off until :func:`enable_child_compilation` (the ``easynav run`` process turns it
+on): tests and scripts compile in-process, as numba does. Whatever goes wrong in the child
+(killed, no writable cache) ends in numba's own in-process compilation, never in an error.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import pickle
+import subprocess
+import sys
+import threading
+
+_LOG = logging.getLogger("easynav.compiled_kernels")
+_enabled = False
+_lock = threading.Lock()
+
+#: Longest a child may take to compile one kernel (MPPI's rollout takes a few seconds).
+CHILD_TIMEOUT = 600.0
+
+
+def enable_child_compilation(enabled: bool = True) -> None:
+    """Compile hooked kernels' new signatures in a child process from now on (or not).
+
+    Thread contract: call at process start, before the kernels run.
+    """
+    global _enabled
+    _enabled = enabled
+
+
+def child_compilation_enabled() -> bool:
+    return _enabled
+
+
+def compile_in_child(dispatcher, locator: str):
+    """Hook ``dispatcher`` (a numba ``njit(cache=True)`` dispatcher) and return it.
+
+    ``locator`` is where a fresh interpreter finds the same dispatcher: ``"module:name"``,
+    ``name`` being the dispatcher or a function without arguments that returns it (a kernel
+    compiled on first use). A dispatcher without a disk cache is returned unhooked: a child
+    could not hand its work over.
+
+    Thread contract: the hook runs under numba's dispatch from any thread; children are
+    started one at a time.
+    """
+    from numba.core.caching import NullCache
+
+    if isinstance(getattr(dispatcher, "_cache", NullCache()), NullCache):
+        return dispatcher
+    numba_compile_for_args = dispatcher._compile_for_args
+
+    def compile_for_args(*args, **kws):
+        # Numba's dispatcher calls this only when no compiled version matches the arguments.
+        if _enabled and not kws:
+            with _lock:
+                if not _load_from_cache(dispatcher, args):
+                    _compile_in_child(locator, dispatcher, args)
+        return numba_compile_for_args(*args, **kws)
+
+    dispatcher._compile_for_args = compile_for_args
+    return dispatcher
+
+
+def _signature(dispatcher, args) -> tuple:
+    return tuple(dispatcher.typeof_pyval(a) for a in args)
+
+
+def _load_from_cache(dispatcher, args) -> bool:
+    """Load the arguments' compiled version from numba's cache into ``dispatcher`` (as numba's
+    ``Dispatcher.compile`` does first); False when the cache does not hold it."""
+    signature = _signature(dispatcher, args)
+    if signature in dispatcher.overloads:
+        return True
+    cres = dispatcher._cache.load_overload(signature, dispatcher.targetctx)
+    if cres is None:
+        return False
+    if not cres.objectmode:
+        dispatcher.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+    dispatcher.add_overload(cres)
+    return True
+
+
+def _compile_in_child(locator: str, dispatcher, args) -> None:
+    payload = pickle.dumps((locator, _signature(dispatcher, args)))
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "easynav.common.compiled_kernels"],
+            input=payload, capture_output=True, timeout=CHILD_TIMEOUT, check=False,
+        )
+    except (OSError, subprocess.TimeoutExpired) as error:
+        _LOG.warning("compiling %s in a child process failed (%s): compiling here", locator,
+                     error)
+        return
+    if done.returncode != 0:
+        _LOG.warning("compiling %s in a child process failed (exit %d): compiling here. %s",
+                     locator, done.returncode, done.stderr.decode(errors="replace")[-500:])
+
+
+def resolve(locator: str):
+    """The dispatcher ``locator`` names (see :func:`compile_in_child`)."""
+    module_name, _, name = locator.partition(":")
+    found = getattr(importlib.import_module(module_name), name)
+    if not hasattr(found, "overloads"):  # a function returning the dispatcher
+        found = found()
+    return found
+
+
+def _child_main() -> int:
+    locator, signature = pickle.loads(sys.stdin.buffer.read())
+    dispatcher = resolve(locator)
+    dispatcher.compile(signature)  # compiled and written to numba's cache
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_child_main())
