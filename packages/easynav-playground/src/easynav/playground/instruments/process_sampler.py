@@ -32,15 +32,16 @@ def find_easynav(run_dir: Path) -> int | None:
 
 
 def cpu_seconds_and_rss(pid: int) -> tuple[float, float] | None:
-    """CPU seconds used so far (user + system, all threads) and resident memory in MB; None
-    when the process is gone."""
+    """CPU seconds used so far (user + system, all threads, and the children it has waited for:
+    numba kernels compiled by a child process count as the run's) and resident memory in MB;
+    None when the process is gone."""
     try:
         fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
         rss_pages = int(Path(f"/proc/{pid}/statm").read_text().split()[1])
     except (OSError, IndexError, ValueError):
         return None
-    utime, stime = int(fields[11]), int(fields[12])
-    return (utime + stime) / CLOCK_TICKS, rss_pages * PAGE / 1e6
+    utime, stime, cutime, cstime = (int(f) for f in fields[11:15])
+    return (utime + stime + cutime + cstime) / CLOCK_TICKS, rss_pages * PAGE / 1e6
 
 
 class ProcessSampler(threading.Thread):
