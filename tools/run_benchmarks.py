@@ -26,8 +26,8 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-#: Per script. The whole-stack benchmark alone patrols 2 x 10 simulated minutes at real time
-#: (about 22 min with start-up); the others take seconds to a few minutes.
+#: Per script. The whole-stack benchmark alone patrols 3 + 2 x 10 simulated minutes at real
+#: time (about 35 min with start-up); the others take seconds to a few minutes.
 TIMEOUT = 2700.0
 
 
