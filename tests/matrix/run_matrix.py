@@ -9,7 +9,8 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --results  where each finished run is kept, one JSON line per run (default
              build/matrix/results.jsonl). A later call skips the combinations already there,
              so the full matrix (hundreds of missions, many hours) can run in parts: stop it
-             at any time and start it again. docs/matrix.md is written from the file.
+             at any time (Ctrl-C or SIGTERM: runs in progress finish and are kept, queued
+             ones do not start) and start it again. docs/matrix.md is written from the file.
   --fresh    forget the results file first
   --only S   only the combinations whose name contains one of the comma-separated S
   --list     print the combinations and exit
@@ -21,6 +22,7 @@ import argparse
 import json
 import os
 import platform
+import signal
 import subprocess
 import sys
 import tempfile
@@ -85,11 +87,18 @@ def run_one(name: str, run_dir: Path, speed_up: float, worlds: tuple[str, ...]) 
     return 0
 
 
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
 def _run_in_process(name: str, run_dir: Path, args: argparse.Namespace) -> dict:
     """One combination in a process of its own (its own ROS domain, its own interpreter)."""
     cmd = [sys.executable, __file__, "--run-one", name, "--run-dir", str(run_dir),
            "--speed-up", str(args.speed_up), "--worlds", args.worlds]
-    done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ))
+    # A session of its own: Ctrl-C in the terminal stops the runner (which lets the runs in
+    # progress finish and be kept), not the missions half-way, which would be kept as failures.
+    done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ),
+                          start_new_session=True)
     lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
     if lines:
         return json.loads(lines[-1])
@@ -162,11 +171,17 @@ def main(argv: list[str]) -> int:
             print(f"[{finished[0]}/{len(todo)}] {combo.name}: {verdict} ({row['seconds']:.0f} s)",
                   flush=True)
 
+    # SIGTERM (a job's time limit, `kill`) stops it the way Ctrl-C does.
+    signal.signal(signal.SIGTERM, _interrupt)
+    pool = ThreadPoolExecutor(max_workers=args.jobs)
     try:
-        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            list(pool.map(run, enumerate(todo, 1)))
+        for future in [pool.submit(run, item) for item in enumerate(todo, 1)]:
+            future.result()
     except KeyboardInterrupt:
-        print("interrupted: the finished runs are kept; run again to go on", flush=True)
+        print("interrupted: waiting for the runs in progress; the finished runs are kept, run "
+              "again to go on", flush=True)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)  # queued runs never start
     outcomes = [
         Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"])
         for c in combos if c.name in kept
