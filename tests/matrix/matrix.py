@@ -355,6 +355,21 @@ def _num(value, fmt: str) -> str:
     return format(value, fmt)
 
 
+def _failure(outcome: Outcome) -> str:
+    """What a user would notice first: collisions, goals missed, then the run's own message
+    (which can be the navigation's result, "Navigation successfully finished", when the
+    mission failed on a collision)."""
+    s = outcome.summary
+    found = []
+    if s.get("collisions"):
+        found.append(f"{s['collisions']} collision(s)")
+    if s.get("waypoints") and s.get("reached", 0) < s["waypoints"]:
+        found.append(f"{s.get('reached', 0)} of {s['waypoints']} waypoints reached")
+    if outcome.error:
+        found.append(outcome.error)
+    return "; ".join(found) or "see the run"
+
+
 def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | None = None) -> str:
     """docs/matrix.md: one row per run, then the plugins that are in no combination."""
     lines = [
@@ -366,7 +381,7 @@ def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | N
     ]
     for o in outcomes:
         s, c = o.summary, o.combination
-        verdict = "green" if o.green else f"**FAILED**: {o.error or 'see the run'}"
+        verdict = "green" if o.green else f"**FAILED**: {_failure(o)}"
         lines.append(
             f"| `{c.maps_manager}` | `{c.localizer}` | `{c.planner}` | `{c.controller}` | "
             f"{c.world} | {s.get('reached', 0)}/{s.get('waypoints', '?')} | "

@@ -1,7 +1,7 @@
 """`make matrix`: run the whole integration matrix and write docs/matrix.md.
 
 Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depot]
-       [--speed-up 1.0] [--jobs 1] [--results FILE] [--output docs/matrix.md] [--list]
+       [--speed-up 1.0] [--jobs 1] [--results FILE] [--output docs/matrix.md] [--list] [--report]
 
   --slice    only the combinations that together use every plugin once (what CI runs)
   --jobs N   N missions at once, each in a process of its own (a mission takes about a core
@@ -14,6 +14,7 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --fresh    forget the results file first
   --only S   only the combinations whose name contains one of the comma-separated S
   --list     print the combinations and exit
+  --report   write docs/matrix.md from the results file without running anything
 """
 
 from __future__ import annotations
@@ -113,6 +114,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--worlds", default=",".join(WORLDS))
     parser.add_argument("--speed-up", type=float, default=1.0)
     parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument("--report", action="store_true",
+                        help="write --output from the results file, run nothing")
     parser.add_argument("--results", default=str(DEFAULT_RESULTS))
     parser.add_argument("--fresh", action="store_true")
     parser.add_argument("--only", default="")
@@ -146,8 +149,9 @@ def main(argv: list[str]) -> int:
     if args.fresh:
         results_path.unlink(missing_ok=True)
     kept = load_results(results_path)
-    todo = [c for c in combos if c.name not in kept]
-    print(f"{len(combos)} combinations: {len(combos) - len(todo)} already in {results_path}, "
+    todo = [] if args.report else [c for c in combos if c.name not in kept]
+    done_before = sum(c.name in kept for c in combos)
+    print(f"{len(combos)} combinations: {done_before} already in {results_path}, "
           f"{len(todo)} to run, {args.jobs} at a time", flush=True)
     started = datetime.now(timezone.utc)
     commit = source_commit()
