@@ -44,10 +44,6 @@ def enable_child_compilation(enabled: bool = True) -> None:
     _enabled = enabled
 
 
-def child_compilation_enabled() -> bool:
-    return _enabled
-
-
 def compile_in_child(dispatcher, locator: str):
     """Hook ``dispatcher`` (a numba ``njit(cache=True)`` dispatcher) and return it.
 
@@ -68,23 +64,19 @@ def compile_in_child(dispatcher, locator: str):
     def compile_for_args(*args, **kws):
         # Numba's dispatcher calls this only when no compiled version matches the arguments.
         if _enabled and not kws:
+            signature = tuple(dispatcher.typeof_pyval(a) for a in args)
             with _lock:
-                if not _load_from_cache(dispatcher, args):
-                    _compile_in_child(locator, dispatcher, args)
+                if not _load_from_cache(dispatcher, signature):
+                    _compile_in_child(locator, signature)
         return numba_compile_for_args(*args, **kws)
 
     dispatcher._compile_for_args = compile_for_args
     return dispatcher
 
 
-def _signature(dispatcher, args) -> tuple:
-    return tuple(dispatcher.typeof_pyval(a) for a in args)
-
-
-def _load_from_cache(dispatcher, args) -> bool:
-    """Load the arguments' compiled version from numba's cache into ``dispatcher`` (as numba's
+def _load_from_cache(dispatcher, signature: tuple) -> bool:
+    """Load ``signature``'s compiled version from numba's cache into ``dispatcher`` (as numba's
     ``Dispatcher.compile`` does first); False when the cache does not hold it."""
-    signature = _signature(dispatcher, args)
     if signature in dispatcher.overloads:
         return True
     cres = dispatcher._cache.load_overload(signature, dispatcher.targetctx)
@@ -96,8 +88,8 @@ def _load_from_cache(dispatcher, args) -> bool:
     return True
 
 
-def _compile_in_child(locator: str, dispatcher, args) -> None:
-    payload = pickle.dumps((locator, _signature(dispatcher, args)))
+def _compile_in_child(locator: str, signature: tuple) -> None:
+    payload = pickle.dumps((locator, signature))
     try:
         done = subprocess.run(
             [sys.executable, "-m", "easynav.common.compiled_kernels"],
