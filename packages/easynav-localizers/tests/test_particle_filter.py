@@ -176,3 +176,43 @@ def test_compiled_scoring_pays_from_the_threshold_on():
     assert not compiled_scoring_pays(1, COMPILED_SCORING_MIN_PAIRS - 1)
     assert compiled_scoring_pays(1, COMPILED_SCORING_MIN_PAIRS)
     assert not compiled_scoring_pays(0, 10**9)
+
+
+def filled_block_map() -> SimpleMap:
+    """8 x 8 m at 0.1 m: a building drawn as a filled block (x 2..6, y 2..6) and a wall 0.2 m
+    thick along the map's left edge."""
+    grid = SimpleMap(80, 80, 0.1)
+    grid.cells[20:60, 20:60] = True
+    grid.cells[:, 0:2] = True
+    return grid
+
+
+def test_surface_cells_keep_the_faces_of_a_filled_block_and_whole_walls():
+    from easynav.localizers.particle_filter import SURFACE_DEPTH, surface_cells
+
+    grid = filled_block_map()
+    surface = surface_cells(grid)
+    skin = round(SURFACE_DEPTH / grid.resolution)  # 3 cells
+    assert surface[:, 0:2].all()  # a thin wall (and the map's edge) is all surface
+    block = surface[20:60, 20:60]
+    assert block[:skin, :].all() and block[-skin:, :].all()
+    assert block[:, :skin].all() and block[:, -skin:].all()
+    assert not block[skin:-skin, skin:-skin].any()  # the inside a laser never reaches
+    assert not (surface & ~grid.cells).any()
+
+
+def test_a_scan_that_lands_inside_a_filled_block_no_longer_fits():
+    from easynav.localizers import likelihood_field
+
+    grid = filled_block_map()
+    # The robot at (0.5, 4) facing the block: its points on the block's face at x = 2.
+    truth = np.array([[0.5, 4.0, 0.0]])
+    points = np.column_stack((np.full(31, 1.5), np.linspace(-1.5, 1.5, 31)))
+    too_close = truth + [1.6, 0.0, 0.0]  # the same points 1.6 m inside the block
+    for field in (None, likelihood_field(grid, 0.2)):
+        at_truth, _ = hit_fractions(truth, points, grid, field)
+        inside, _ = hit_fractions(too_close, points, grid, field)
+        assert at_truth[0] > 0.95
+        # Every occupied cell counted, this scored 1.0 as well; now only the points that land
+        # near the block's other faces (its ends at y 2 and 6) count, a little.
+        assert inside[0] < 0.1

@@ -4,6 +4,11 @@ The algorithm (:class:`ParticleFilter2D`, :func:`hit_fractions`) is plain numpy;
 (``easynav.localizers.amcl_localizer``) is not imported here.
 """
 
-from easynav.localizers.particle_filter import ParticleFilter2D, hit_fractions, likelihood_field
+from easynav.localizers.particle_filter import (
+    ParticleFilter2D,
+    hit_fractions,
+    likelihood_field,
+    surface_cells,
+)
 
-__all__ = ["ParticleFilter2D", "hit_fractions", "likelihood_field"]
+__all__ = ["ParticleFilter2D", "hit_fractions", "likelihood_field", "surface_cells"]

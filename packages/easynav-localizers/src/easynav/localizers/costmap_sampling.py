@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from easynav.localizers.particle_filter import occupied_cells
+from easynav.localizers.particle_filter import surface_cells
 
 #: KLD bin sizes (Nav2's AMCL: 0.5 m, 0.5 m, 10°).
 KLD_BIN_XY = 0.5
@@ -72,7 +72,8 @@ def beam_likelihood_field(
     costmap, sigma_hit: float, z_hit: float, z_rand: float, max_range: float, max_dist: float
 ) -> tuple[np.ndarray, float]:
     """Nav2's likelihood-field sensor model as a per-cell table: a point in a cell whose centre
-    is ``d`` metres from the nearest lethal cell (``d`` capped at ``max_dist``) has
+    is ``d`` metres from the nearest lethal surface cell (``d`` capped at ``max_dist``; the
+    surface, :func:`surface_cells`, where Nav2 takes every lethal cell) has
     ``pz = z_hit·exp(-d²/2σ²) + z_rand/max_range``; the table holds ``pz³`` (Nav2 sums the
     cubes: ``weight = 1 + Σ pz³``, much less peaked than a product over 60 beams). Returns the
     ``(height, width)`` float32 table and the ``pz³`` of a point off the map (``z_rand`` only).
@@ -84,7 +85,7 @@ def beam_likelihood_field(
     (about 20 MB resident, issue #21).
     """
     rand = z_rand / max_range
-    obstacles = occupied_cells(costmap)
+    obstacles = surface_cells(costmap)
     if obstacles.any():
         from easynav.maps.inflation import compiled_distances
 

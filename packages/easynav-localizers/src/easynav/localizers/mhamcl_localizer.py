@@ -31,7 +31,7 @@ from easynav.localizers.particle_filter import (
     ParticleFilter2D,
     hit_fractions,
     likelihood_field,
-    occupied_cells,
+    surface_cells,
 )
 
 HYPOTHESES_COUNT = NavStateKey(
@@ -365,12 +365,13 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
 
     def _fields(self, base: Costmap2D) -> tuple[np.ndarray, np.ndarray]:
         """The soft hit field (σ ``distance_perception_error``, zero beyond 3σ) and the
-        quality field (1 within 3σ of a lethal cell), cached per map object and σ."""
+        quality field (1 within 3σ of a lethal surface cell, :func:`surface_cells`), cached
+        per map object and σ."""
         sigma = float(self.params.distance_perception_error)
         key = (base, sigma)  # map.base is replaced, never mutated: cache per object
         if (self._mh_fields_key is None or self._mh_fields_key[0] is not base
                 or self._mh_fields_key[1] != sigma):
-            obstacles = occupied_cells(base)
+            obstacles = surface_cells(base)
             if obstacles.any():
                 free = (~obstacles).astype(np.uint8)
                 d = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)

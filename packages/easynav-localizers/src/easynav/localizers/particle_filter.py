@@ -27,6 +27,38 @@ def occupied_cells(grid) -> np.ndarray:
     return np.asarray(grid.data) == LETHAL
 
 
+#: How deep into an obstacle a range sensor's points may land (m): the skin of
+#: :func:`surface_cells`. A wall up to twice this thick keeps every cell.
+SURFACE_DEPTH = 0.3
+
+
+def surface_cells(grid, depth: float = SURFACE_DEPTH) -> np.ndarray:
+    """The obstacle cells a range sensor can hit: the :func:`occupied_cells` within ``depth``
+    metres (at least one cell, counted in 4-neighbour steps) of a cell that is not occupied
+    or of the map's edge. ``(height, width)`` bool.
+
+    Why not every occupied cell: a laser point lands on an obstacle's face, never inside it.
+    A map that draws a building or a pillar as a filled block (drawn and CAD maps do; a SLAM
+    map leaves the inside unknown) would otherwise score a scan that lands inside the block
+    as a perfect fit, so a pose too close to the block beats the true one and the filter
+    cannot correct it. Measured on the playground's campus (buildings 10-20 m across): 2 m
+    from a building's wall, the true pose's scan fitted worse than the pose 1.6 m closer,
+    whose points fell inside the building (likelihood field 8.4 against 13.6; exact hits 41
+    against 76 of 76 points), and AMCL kept a 1.9 m error. Walls of ordinary thickness are
+    unchanged.
+    """
+    cells = occupied_cells(grid)
+    steps = max(1, int(math.ceil(depth / float(grid.resolution) - 1e-9)))
+    inside = cells
+    for _ in range(steps):
+        if not inside.any():
+            break
+        around = np.pad(inside, 1, constant_values=False)
+        inside = (inside & around[:-2, 1:-1] & around[2:, 1:-1]
+                  & around[1:-1, :-2] & around[1:-1, 2:])
+    return cells & ~inside
+
+
 def _wrap(angles: np.ndarray) -> np.ndarray:
     return (angles + np.pi) % (2.0 * np.pi) - np.pi
 
@@ -34,8 +66,9 @@ def _wrap(angles: np.ndarray) -> np.ndarray:
 def likelihood_field(grid, sigma: float) -> np.ndarray:
     """How much a point in each cell of ``grid`` (a :class:`SimpleMap` or a Costmap2D, see
     :func:`occupied_cells`) counts as a hit: ``exp(-d² / 2σ²)`` for a cell whose centre
-    is ``d`` metres from the nearest occupied cell centre (1 on occupied cells); ``sigma`` 0
-    gives exact hits (1 on occupied cells, 0 elsewhere). ``(height, width)`` float32.
+    is ``d`` metres from the nearest obstacle surface cell centre (:func:`surface_cells`: 1 on
+    them, and low deep inside a filled obstacle); ``sigma`` 0 gives exact hits (1 on surface
+    cells, 0 elsewhere). ``(height, width)`` float32.
 
     The soft version widens the basin around the true pose: a particle 0.3 m off still scores
     better than one 1 m off, so the cloud is pulled towards the truth instead of waiting for
@@ -43,7 +76,7 @@ def likelihood_field(grid, sigma: float) -> np.ndarray:
     """
     if not math.isfinite(sigma) or sigma < 0.0:
         raise ValueError(f"hit sigma = {sigma} must be finite and >= 0")
-    cells = occupied_cells(grid)
+    cells = surface_cells(grid)
     if sigma == 0.0 or not cells.any():
         return cells.astype(np.float32)
     import cv2  # here: a process that never needs a soft field does not load OpenCV
@@ -62,11 +95,12 @@ def hit_fractions(
     compiled: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     """For each particle pose ``(x, y, yaw)``: the fraction of ``points_xy`` (robot frame) that
-    hit occupied cells of ``grid`` (a :class:`SimpleMap` or a Costmap2D, see
-    :func:`occupied_cells`), and how many landed on the map at all.
+    hit obstacle surface cells of ``grid`` (a :class:`SimpleMap` or a Costmap2D, see
+    :func:`surface_cells`), and how many landed on the map at all.
 
     ``field`` (from :func:`likelihood_field`) says how much a point in each cell counts as a
-    hit; None counts exact hits on occupied cells (the original's score). A particle whose
+    hit; None counts exact hits on surface cells (the original's score, which counts every
+    occupied cell: the same on walls of ordinary thickness). A particle whose
     points all fall off the map scores 0. Vectorised over particles × points, in float32 cell
     units and ``chunk`` particles at a time, which keeps the intermediate arrays in cache (4–5×
     faster than one float64 pass for 1000 particles). With numba installed (and ``compiled``)
@@ -80,7 +114,7 @@ def hit_fractions(
     if n == 0 or len(points_xy) == 0 or grid.width == 0 or grid.height == 0:
         return fractions, possible
     if field is None:
-        field = occupied_cells(grid).astype(np.float32)
+        field = surface_cells(grid).astype(np.float32)
     elif field.shape != (grid.height, grid.width):
         raise ValueError(
             f"likelihood field shape {field.shape} != map shape {(grid.height, grid.width)}"
