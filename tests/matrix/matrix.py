@@ -39,6 +39,8 @@ from easynav.system.cli.params_file import load_ros_yaml
 ROOT = Path(__file__).resolve().parents[2]
 PARAMS_DIR = ROOT / "params"
 BASE_PARAMS = PARAMS_DIR / "playground.params.yaml"
+#: The failures that were looked into, with their causes (see :class:`Finding`).
+FINDINGS = Path(__file__).resolve().with_name("findings.yaml")
 
 #: Distributions whose plugins are not navigation plugins (Dummy plugins, fault injectors, the
 #: playground's measuring instruments).
@@ -93,6 +95,47 @@ class Outcome:
     @property
     def green(self) -> bool:
         return self.exit_code == 0 and bool(self.summary.get("success"))
+
+
+@dataclass(frozen=True)
+class Finding:
+    """A failure of the matrix that was looked into: which rows it explains (those using every
+    one of ``plugins`` in one of ``worlds``, any world when empty) and what was found. The
+    report puts ``cause`` in the verdict of each failed row it explains; a green row ignores it
+    (the failure may be intermittent, or fixed since)."""
+
+    plugins: tuple[str, ...]
+    worlds: tuple[str, ...]
+    cause: str
+
+    def explains(self, combo: Combination) -> bool:
+        return set(self.plugins) <= set(combo.plugins) and (
+            not self.worlds or combo.world in self.worlds
+        )
+
+
+def load_findings(path: Path = FINDINGS) -> list[Finding]:
+    """The findings of ``path`` (a YAML list of ``{plugins, worlds, cause}``); none when the
+    file does not exist. Raises ValueError naming the file and the entry that is malformed."""
+    if not path.exists():
+        return []
+    document = yaml.safe_load(path.read_text()) or []
+    if not isinstance(document, list):
+        raise ValueError(f"{path}: expected a list of findings, got {type(document).__name__}")
+    findings = []
+    for i, entry in enumerate(document, 1):
+        if not isinstance(entry, dict) or set(entry) - {"plugins", "worlds", "cause"}:
+            raise ValueError(f"{path}: finding {i}: expected the keys plugins, worlds, cause")
+        plugins, worlds, cause = entry.get("plugins"), entry.get("worlds", []), entry.get("cause")
+        if (not isinstance(plugins, list) or not plugins
+                or not all(isinstance(p, str) for p in plugins)):
+            raise ValueError(f"{path}: finding {i}: plugins must be a non-empty list of names")
+        if not isinstance(worlds, list) or not all(isinstance(w, str) for w in worlds):
+            raise ValueError(f"{path}: finding {i}: worlds must be a list of world names")
+        if not isinstance(cause, str) or not cause.strip():
+            raise ValueError(f"{path}: finding {i}: cause must say what was found")
+        findings.append(Finding(tuple(plugins), tuple(worlds), " ".join(cause.split())))
+    return findings
 
 
 def navigation_plugins() -> dict[str, list[str]]:
@@ -370,7 +413,19 @@ def _failure(outcome: Outcome) -> str:
     return "; ".join(found) or "see the run"
 
 
-def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | None = None) -> str:
+def verdict(outcome: Outcome, findings: list[Finding] = ()) -> str:
+    """A row's verdict: green, or what failed and why (the findings that explain it), or that
+    nobody has looked into it yet."""
+    if outcome.green:
+        return "green"
+    causes = [f.cause for f in findings if f.explains(outcome.combination)]
+    if causes:
+        return f"**FAILED**: {_failure(outcome)}. Why: {' '.join(causes)}"
+    return f"**FAILED** (not looked into yet): {_failure(outcome)}"
+
+
+def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | None = None,
+             findings: list[Finding] = ()) -> str:
     """docs/matrix.md: one row per run, then the plugins that are in no combination."""
     lines = [
         header,
@@ -381,17 +436,19 @@ def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | N
     ]
     for o in outcomes:
         s, c = o.summary, o.combination
-        verdict = "green" if o.green else f"**FAILED**: {_failure(o)}"
         lines.append(
             f"| `{c.maps_manager}` | `{c.localizer}` | `{c.planner}` | `{c.controller}` | "
             f"{c.world} | {s.get('reached', 0)}/{s.get('waypoints', '?')} | "
             f"{_num(s.get('navigation_time'), '.1f')} | {_num(s.get('distance_driven'), '.1f')} | "
             f"{_num(s.get('min_clearance'), '.2f')} | "
             f"{_num(s.get('localisation_mean'), '.3f')} / {_num(s.get('localisation_max'), '.3f')}"
-            f" | {_num(s.get('late_rt_cycles'), 'd')} | {verdict.replace('|', '/')} |"
+            f" | {_num(s.get('late_rt_cycles'), 'd')} | {verdict(o, findings).replace('|', '/')} |"
         )
     green = sum(o.green for o in outcomes)
-    lines += ["", f"{green} of {len(outcomes)} runs green.", ""]
+    explained = sum(not o.green and any(f.explains(o.combination) for f in findings)
+                    for o in outcomes)
+    lines += ["", f"{green} of {len(outcomes)} runs green; of the {len(outcomes) - green} "
+              f"failed, {explained} explained (tests/matrix/findings.yaml).", ""]
     if unmatched:
         lines += ["Installed navigation plugins in no combination (nothing to run them with):", ""]
         lines += [f"- `{name}`: {reason}" for name, reason in sorted(unmatched.items())]

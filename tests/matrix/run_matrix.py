@@ -15,6 +15,10 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --only S   only the combinations whose name contains one of the comma-separated S
   --list     print the combinations and exit
   --report   write docs/matrix.md from the results file without running anything
+
+A failed row's verdict says what a user would notice first (collisions, waypoints missed, the
+run's message) and, when the failure was looked into, why: tests/matrix/findings.yaml lists the
+causes found, each for the rows it explains; a failure nobody looked into says so.
 """
 
 from __future__ import annotations
@@ -41,6 +45,7 @@ from matrix import (  # noqa: E402 (the folder is not a package)
     Outcome,
     combinations,
     covering_slice,
+    load_findings,
     markdown,
     run_combination,
     unmatched_plugins,
@@ -77,6 +82,9 @@ def source_commit() -> str:
 
 def run_one(name: str, run_dir: Path, speed_up: float, worlds: tuple[str, ...]) -> int:
     """``--run-one``: run one combination here and print its row as one JSON line."""
+    # SIGTERM stops the mission the way Ctrl-C does: the demo stops the simulator and EasyNav
+    # (the default action would leave them running, orphaned) and the row says "interrupted".
+    signal.signal(signal.SIGTERM, _interrupt)
     combo = next((c for c in combinations(worlds) if c.name == name), None)
     if combo is None:
         print(json.dumps({"name": name, "exit_code": 2, "summary": {},
@@ -90,6 +98,12 @@ def run_one(name: str, run_dir: Path, speed_up: float, worlds: tuple[str, ...]) 
 
 def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
+
+
+def _stopped_half_way(row: dict) -> bool:
+    """A mission stopped from outside (a signal) rather than ended: its row is not a result."""
+    return (row.get("exit_code", 0) < 0 or row.get("exit_code") == 130
+            or row.get("summary", {}).get("final_state") == "INTERRUPTED")
 
 
 def _run_in_process(name: str, run_dir: Path, args: argparse.Namespace) -> dict:
@@ -165,6 +179,10 @@ def main(argv: list[str]) -> int:
         row = _run_in_process(combo.name, work / f"{i:03d}", args)
         row["seconds"] = round(time.monotonic() - t0, 1)
         row["commit"] = commit
+        if _stopped_half_way(row):  # a mission killed on its own is no result: run it again
+            print(f"[-] {combo.name}: stopped before its end ({row['error']}), not kept",
+                  flush=True)
+            return
         with lock:
             with results_path.open("a") as f:
                 f.write(json.dumps(row) + "\n")
@@ -214,7 +232,7 @@ def main(argv: list[str]) -> int:
         + (", ".join(f"{key} ({n} rows)" for key, n in sorted(commits.items())) or "none yet"),
     ])
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.output).write_text(markdown(outcomes, header, unmatched))
+    Path(args.output).write_text(markdown(outcomes, header, unmatched, load_findings()))
     print(f"wrote {args.output}")
     return 0 if len(outcomes) == len(combos) and all(o.green for o in outcomes) else 1
 

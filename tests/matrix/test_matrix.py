@@ -9,14 +9,20 @@ from __future__ import annotations
 import pytest
 from matrix import (
     AXES,
+    WORLDS,
     Combination,
+    Finding,
+    Outcome,
     combinations,
     compose_params,
     covering_slice,
+    load_findings,
+    markdown,
     navigation_plugins,
     representative_sections,
     run_combination,
     unmatched_plugins,
+    verdict,
 )
 
 from easynav.core.plugins.compatibility import compatible, needed_maps, provided_maps
@@ -69,6 +75,42 @@ def test_composed_params_take_each_plugin_from_its_representative_file():
             assert params["matrix"] == sections[plugin]["section"]
     heartbeat = document["system_node"]["ros__parameters"]["safety"]["heartbeat"]
     assert heartbeat["period"] > 0
+
+
+def test_a_failed_row_says_why_when_a_finding_explains_it():
+    combo = Combination("m/M", "l/L", "p/P", "c/C", "campus")
+    failed = Outcome(combo, 1, {"collisions": 1, "waypoints": 5, "reached": 3},
+                     "no result within 600 s")
+    green = Outcome(combo, 0, {"success": True, "waypoints": 5, "reached": 5})
+    found = Finding(("l/L", "c/C"), ("campus",), "the localizer drifts.")
+    elsewhere = Finding(("l/L",), ("home",), "something else.")
+    assert verdict(failed, [found, elsewhere]) == (
+        "**FAILED**: 1 collision(s); 3 of 5 waypoints reached; no result within 600 s. "
+        "Why: the localizer drifts."
+    )
+    assert verdict(failed, [elsewhere]).startswith("**FAILED** (not looked into yet): 1 coll")
+    assert verdict(green, [found]) == "green"
+    text = markdown([failed, green], "# header", findings=[found])
+    assert "Why: the localizer drifts." in text
+    assert "1 of 2 runs green; of the 1 failed, 1 explained" in text
+
+
+def test_the_shipped_findings_name_installed_plugins_and_matrix_worlds():
+    installed = {name for names in navigation_plugins().values() for name in names}
+    for finding in load_findings():
+        assert set(finding.plugins) <= installed, finding
+        assert set(finding.worlds) <= set(WORLDS), finding
+
+
+def test_a_malformed_finding_is_refused_naming_it(tmp_path):
+    path = tmp_path / "findings.yaml"
+    path.write_text("- plugins: [a/A]\n  cause: fine\n- plugins: a/A\n  cause: x\n")
+    with pytest.raises(ValueError, match="finding 2: plugins must be a non-empty list"):
+        load_findings(path)
+    path.write_text("- plugins: [a/A]\n  why: typo\n")
+    with pytest.raises(ValueError, match="finding 1: expected the keys plugins, worlds, cause"):
+        load_findings(path)
+    assert load_findings(tmp_path / "absent.yaml") == []
 
 
 # CI's slice drives in the home world (roomy: every stack's tuning fits it); the full matrix
