@@ -166,14 +166,16 @@ def test_obstacles_filter_marks_the_navcel_under_the_column(tmp_path):
     manager.update(nav_state)
     navmap = nav_state.get(MAP_NAVMAP)
     layer = navmap.layer("obstacles")
-    assert (layer == 254).sum() == 1
-    cid = int(np.flatnonzero(layer == 254)[0])
+    walls = navmap.layer("occupancy") == 254  # the grid's static obstacles, always marked
+    assert walls.any() and (layer[walls] == 254).all()
+    assert (layer[~walls] == 254).sum() == 1
+    cid = int(np.flatnonzero((layer == 254) & ~walls)[0])
     # the column (6, 6) of 0.3 m: centre (1.95, 1.95) in the map, on the NavCels of cell (19, 19)
     assert cid in (2 * (19 * 40 + 19), 2 * (19 * 40 + 19) + 1)
-    # cleared next cycle when the post is gone
+    # cleared next cycle when the post is gone; the walls stay
     nav_state.set("laser1", PointPerception(np.empty((0, 3)), "laser", 99.5))
     manager.update(nav_state)
-    assert (nav_state.get(MAP_NAVMAP).layer("obstacles") == 0).all()
+    np.testing.assert_array_equal(nav_state.get(MAP_NAVMAP).layer("obstacles") == 254, walls)
     # the map of the manager itself is never touched
     assert not manager.navmap.has_layer("obstacles")
 
@@ -273,6 +275,29 @@ def test_inflation_cost_formula():
     exp = [254, 253, 253] + [int(np.floor(252 * np.exp(-3 * (x - 0.3)) + 0.5))
                              for x in (0.31, 0.45, 0.6)] + [0, 0]
     assert got == exp
+
+
+def test_a_grid_maps_walls_are_obstacles_without_any_perception(tmp_path):
+    # A room with an inner wall at x 2.0 .. 2.1 from y 0 to 3 (of 4): a NavMap converted from
+    # it keeps the wall only in its layer 'occupancy', which the NavMap planner does not read.
+    pixels = np.full((40, 40), 254, dtype=np.uint8)
+    pixels[0, :] = pixels[-1, :] = pixels[:, 0] = pixels[:, -1] = 0
+    pixels[10:, 20] = 0  # image row 0 is the top: rows 10.. are y 0 .. 3
+    cv2.imwrite(str(tmp_path / "wall.pgm"), pixels)
+    (tmp_path / "wall.yaml").write_text(
+        "image: wall.pgm\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    manager = make_manager({"occmap_path_file": str(tmp_path / "wall.yaml"),
+                            **filters(("obstacles", OBSTACLES), ("inflation", INFLATION))})
+    nav_state = NavState()
+    manager.update(nav_state)  # no perception at all
+    navmap = nav_state.get(MAP_NAVMAP)
+    for layer in ("obstacles", "inflated_obstacles"):
+        costs = navmap.layer(layer)
+        assert costs[navmap.locate_navcel((2.05, 1.5, 0))] == 254, layer
+        assert costs[navmap.locate_navcel((2.05, 3.5, 0))] < 254, layer  # the gap above it
+        assert costs[navmap.locate_navcel((1.0, 1.5, 0))] == 0, layer
 
 
 def test_manager_with_both_filters(tmp_path):

@@ -78,7 +78,8 @@ def test_topics_and_savemap(ros, tmp_path, monkeypatch):
     fields = sorted(f.name for m in updates[:2] for f in m.fields if f.name not in "xyz")
     assert fields == ["inflated_obstacles", "obstacles"]
     table = np.frombuffer(bytes(updates[0].data), "<f4").reshape(-1, 4)
-    assert (table[:, 3] == 254).sum() == 1
+    walls = 2 * 20  # the map's occupied top row (2 NavCels a cell), marked by the filter too
+    assert (table[:, 3] == 254).sum() == walls + 1
 
     client = ros.node.create_client(Trigger, f"{base}/savemap")
     assert client.wait_for_service(timeout_sec=5.0)
@@ -86,7 +87,7 @@ def test_topics_and_savemap(ros, tmp_path, monkeypatch):
     assert ros.spin_until(future.done)
     assert future.result().success, future.result().message
     saved = load_navmap(tmp_path / "s.navmap")
-    assert (saved.layer("obstacles") == 254).sum() == 1
+    assert (saved.layer("obstacles") == 254).sum() == walls + 1
 
     grid = OccupancyGrid(resolution=0.25, data=np.zeros((4, 8), np.int8))
     grid.header.frame_id = "map"

@@ -19,6 +19,9 @@ RANGE_XY = 10.0
 VOXEL_XY = 0.30
 VOXEL_Z = 0.20
 HEIGHT_THRESHOLD = 0.25
+#: The layer of a NavMap converted from an occupancy grid that holds the grid's cells (254 where
+#: it was occupied): its obstacles are static obstacles.
+STATIC_LAYER = "occupancy"
 
 
 def obstacle_columns(points: np.ndarray) -> np.ndarray:
@@ -59,8 +62,16 @@ class ObstaclesFilter(NavMapFilter):
     gives the columns tall enough to be obstacles; each column's top point is located on the
     mesh (:meth:`NavMap.locate`: the surface nearest in height along the vertical, which is what
     the original's ``locate_navcel`` returns — its 0.5 m ``height_eps`` gates only its hint
-    shortcut) and that NavCel set to 254. Without perceptions the layer stays clear (a throttled
-    warning).
+    shortcut) and that NavCel set to 254. Without perceptions only the static obstacles are
+    marked (a throttled warning).
+
+    Not in the original: the lethal NavCels of the layer ``occupancy`` (:data:`STATIC_LAYER`, the
+    walls of a NavMap converted from a map_server grid) are marked too, before the perceptions,
+    like Nav2's static layer under its obstacle layer. The original clears the layer to 0, so
+    its planner, which reads ``inflated_obstacles`` or ``obstacles`` only, planned through the
+    grid's walls unless a 3D sensor saw them: a 2D laser never marks a column (its points span
+    one height), and in the integration matrix the NavMap stack drove into the first wall of
+    the home world. A mesh loaded as it is has no ``occupancy`` layer: its walls are holes.
 
     Thread contract: as :class:`NavMapFilter` (non-RT thread). TF failures skip the perception
     with a warning (PointPerceptionsOps), they never raise.
@@ -81,6 +92,8 @@ class ObstaclesFilter(NavMapFilter):
                 self.logger, "no-perceptions", f"{self.plugin_name}: no point perceptions"
             )
         layer = navmap.layer_clear(self.LAYER_NAME, FREE_SPACE, np.uint8)
+        if navmap.has_layer(STATIC_LAYER):
+            layer[navmap.layer(STATIC_LAYER) == LETHAL_OBSTACLE] = LETHAL_OBSTACLE
         if not perceptions:
             return
         buffer = get_tf_buffer(self.context.namespace)
