@@ -193,18 +193,36 @@ def combinations(worlds: tuple[str, ...] = WORLDS) -> list[Combination]:
             needs = needed_maps(classes[("maps manager", extra)])
             if needs and compatible(needs, provided_maps(base_cls)):
                 stacks.append((base, extra))
+    # Pairs of maps managers that need no map, for a plugin that needs maps of both (the NavMap
+    # AMCL: the NavMap and the Bonxai voxels). Such a stack only runs the combinations where some
+    # plugin needs the pair: the others are the single stacks' again.
+    users = [classes[(kind, name)] for kind in ("localizer", "planner", "controller")
+             for name in plugins[kind]]
+
+    def provides_of(stack: tuple[str, ...]) -> set[str]:
+        return {rep for m in stack for rep in provided_maps(classes[("maps manager", m)])}
+
+    def needs_pair(cls: type, pair: tuple[str, str]) -> bool:
+        fits = [compatible(needed_maps(cls), provides_of(s), required_maps(cls))
+                for s in (pair, pair[:1], pair[1:])]
+        return fits[0] and not fits[1] and not fits[2]
+
+    bases = [m for m in plugins["maps manager"] if not needed_maps(classes[("maps manager", m)])]
+    pairs = [pair for pair in itertools.combinations(bases, 2)
+             if any(needs_pair(cls, pair) for cls in users)]
+    stacks += pairs
     sensors_of = {world: world_sensors(world) for world in worlds}
     combos = []
     for stack, loc, plan, ctrl in itertools.product(
         stacks, plugins["localizer"], plugins["planner"], plugins["controller"]
     ):
-        provides = {rep for m in stack for rep in provided_maps(classes[("maps manager", m)])}
+        provides = provides_of(stack)
         maps = "+".join(stack)
-        if not all(
-            compatible(needed_maps(cls), provides, required_maps(cls))
-            for cls in (classes[(kind, name)] for kind, name in
-                        (("localizer", loc), ("planner", plan), ("controller", ctrl)))
-        ):
+        chosen = [classes[(kind, name)] for kind, name in
+                  (("localizer", loc), ("planner", plan), ("controller", ctrl))]
+        if not all(compatible(needed_maps(cls), provides, required_maps(cls)) for cls in chosen):
+            continue
+        if stack in pairs and not any(needs_pair(cls, stack) for cls in chosen):
             continue
         needs = set().union(*(
             needed_sensors(classes[(kind, name)])
@@ -245,8 +263,8 @@ def unmatched_plugins(combos: list[Combination]) -> dict[str, str]:
             elif required_maps(cls):
                 reasons[name] = (
                     f"needs {' or '.join(needed_maps(cls))} and {' and '.join(required_maps(cls))}"
-                    " from two maps managers: the matrix's stacks pair a maps manager only with "
-                    "one working on its map"
+                    ": no two installed maps managers provide them, or no partner of another "
+                    "axis works beside them"
                 )
             elif needed_sensors(cls):
                 reasons[name] = (
