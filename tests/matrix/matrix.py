@@ -374,9 +374,29 @@ def compose_params(combo: Combination, sections: dict[str, dict] | None = None) 
         for alias, plugin in zip(aliases, plugins, strict=True):
             known = sections.get(plugin)
             params[alias] = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
+    _read_the_robots_sensors(document)
     system = document.setdefault("system_node", {}).setdefault("ros__parameters", {})
     system.setdefault("safety", {}).setdefault("heartbeat", {})["period"] = 0.5
     return document
+
+
+def _read_the_robots_sensors(document: dict) -> None:
+    """A maps manager whose section reads a perception group that no sensor of the playground's
+    robot is in (the voxel maps' 3D lidar, ``points3d``: no world of the matrix has one) reads
+    the ungrouped perceptions instead, the 2D laser, as its user would configure it on a robot
+    with a laser only. Left as it is, the stack drives on its static map alone, blind to what
+    it passes: on the campus the Bonxai stack cut the cafeteria's corner whenever AMCL's
+    along-track error (0.26-0.32 m where no feature across the track is within the laser's
+    range) put the robot closer to it than it believed; a stack that marks its laser's hits
+    sees the corner where it is."""
+    sensors = (document.get("sensors_node") or {}).get("ros__parameters") or {}
+    groups = {str((sensors.get(name) or {}).get("group", ""))
+              for name in sensors.get("sensors") or []}
+    maps = (document.get("maps_manager_node") or {}).get("ros__parameters") or {}
+    for alias in maps.get("map_types") or []:
+        section = maps.get(alias)
+        if isinstance(section, dict) and section.get("perception_group", "") not in groups | {""}:
+            section["perception_group"] = ""
 
 
 def run_combination(

@@ -77,6 +77,26 @@ def test_composed_params_take_each_plugin_from_its_representative_file():
     assert heartbeat["period"] > 0
 
 
+def test_a_maps_manager_reading_a_sensor_group_the_robot_lacks_reads_its_laser():
+    # The Bonxai section reads the 3D lidar's group (points3d); the playground's robot has a
+    # 2D laser only (ungrouped), so the composed stack gives the voxel map the laser's points.
+    sections = representative_sections()
+    bonxai = "easynav_bonxai_maps_manager/BonxaiMapsManager"
+    assert sections[bonxai]["section"]["perception_group"] == "points3d"
+    combo = next(c for c in combinations(("home",)) if c.maps_managers == (bonxai,))
+    document = compose_params(combo, sections)
+    assert document["maps_manager_node"]["ros__parameters"]["matrix"]["perception_group"] == ""
+    # A group that a sensor of the robot is in is kept.
+    sensors = document["sensors_node"]["ros__parameters"]
+    sensors["laser"]["group"] = "points3d"
+    maps = document["maps_manager_node"]["ros__parameters"]
+    maps["matrix"]["perception_group"] = "points3d"
+    from matrix import _read_the_robots_sensors
+
+    _read_the_robots_sensors(document)
+    assert maps["matrix"]["perception_group"] == "points3d"
+
+
 def test_a_failed_row_says_why_when_a_finding_explains_it():
     combo = Combination("m/M", "l/L", "p/P", "c/C", "campus")
     failed = Outcome(combo, 1, {"collisions": 1, "waypoints": 5, "reached": 3},
