@@ -374,10 +374,47 @@ def compose_params(combo: Combination, sections: dict[str, dict] | None = None) 
         for alias, plugin in zip(aliases, plugins, strict=True):
             known = sections.get(plugin)
             params[alias] = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
+    _add_the_sensors_they_read(document, combo, sections)
     _read_the_robots_sensors(document)
     system = document.setdefault("system_node", {}).setdefault("ros__parameters", {})
     system.setdefault("safety", {}).setdefault("heartbeat", {})["period"] = 0.5
     return document
+
+
+#: The kind of robot sensor (:func:`world_sensors`) behind each sensor message type.
+SENSOR_KINDS = {
+    "sensor_msgs/msg/LaserScan": "laser",
+    "sensor_msgs/msg/Imu": "imu",
+    "sensor_msgs/msg/NavSatFix": "gnss",
+    "sensor_msgs/msg/PointCloud2": "lidar",
+}
+
+
+def _add_the_sensors_they_read(document: dict, combo: Combination, sections: dict) -> None:
+    """The sensors_node sensors of each chosen plugin's representative params file, where the
+    world's robot has that kind of sensor (:data:`SENSOR_KINDS`): the fusion and GTSAM
+    localizers read their GNSS fixes through sensors_node (group ``gnss``), which the
+    playground's own file (a laser) does not declare; without them they never had a fix to
+    start from, and no pose. A sensor the base file already declares by name is kept."""
+    sensors = document.setdefault("sensors_node", {}).setdefault("ros__parameters", {})
+    names = sensors.setdefault("sensors", [])
+    robot = world_sensors(combo.world)
+    for plugin in combo.plugins:
+        known = sections.get(plugin)
+        if not known:
+            continue
+        try:
+            source = load_ros_yaml((PARAMS_DIR / known["file"]).read_text())
+        except (OSError, yaml.YAMLError):
+            continue
+        theirs = ((source or {}).get("sensors_node") or {}).get("ros__parameters") or {}
+        for name in theirs.get("sensors") or []:
+            sensor = theirs.get(name)
+            if (name in names or not isinstance(sensor, dict)
+                    or SENSOR_KINDS.get(sensor.get("type")) not in robot):
+                continue
+            names.append(name)
+            sensors[name] = copy.deepcopy(sensor)
 
 
 def _read_the_robots_sensors(document: dict) -> None:

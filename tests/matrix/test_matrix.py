@@ -6,6 +6,8 @@ runs every combination in every world and writes docs/matrix.md.
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 from matrix import (
     AXES,
@@ -72,7 +74,10 @@ def test_composed_params_take_each_plugin_from_its_representative_file():
         assert params[types_key][0] == "matrix"
         assert params["matrix"]["plugin"] == plugin
         if plugin in sections:
-            assert params["matrix"] == sections[plugin]["section"]
+            expected = dict(sections[plugin]["section"])
+            if "perception_group" in expected:  # read from the robot's sensors (test below)
+                expected["perception_group"] = params["matrix"]["perception_group"]
+            assert params["matrix"] == expected
     heartbeat = document["system_node"]["ros__parameters"]["safety"]["heartbeat"]
     assert heartbeat["period"] > 0
 
@@ -95,6 +100,20 @@ def test_a_maps_manager_reading_a_sensor_group_the_robot_lacks_reads_its_laser()
 
     _read_the_robots_sensors(document)
     assert maps["matrix"]["perception_group"] == "points3d"
+
+
+def test_a_localizer_gets_the_sensors_its_file_declares_where_the_robot_has_them():
+    # The fusion localizer reads GNSS fixes through sensors_node (group gnss): the campus
+    # robot has a receiver, so the composed stack declares it; the home robot has none.
+    sections = representative_sections()
+    fusion = "easynav_fusion_localizer/FusionLocalizer"
+    combo = next(c for c in combinations(("campus",)) if c.localizer == fusion)
+    sensors = compose_params(combo, sections)["sensors_node"]["ros__parameters"]
+    assert "gps" in sensors["sensors"] and sensors["gps"]["group"] == "gnss"
+    assert sensors["gps"]["type"] == "sensor_msgs/msg/NavSatFix"
+    assert "laser" in sensors["sensors"]  # the playground's own
+    indoors = compose_params(dataclasses.replace(combo, world="home"), sections)
+    assert indoors["sensors_node"]["ros__parameters"]["sensors"] == ["laser"]
 
 
 def test_a_failed_row_says_why_when_a_finding_explains_it():

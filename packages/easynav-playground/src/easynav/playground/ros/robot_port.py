@@ -104,7 +104,13 @@ class RobotPort:
             self._imu_pub = node.create_publisher(messages.Imu, topic("imu/data"), _RELIABLE)
             simulation.add_periodic(imu.period, self.publish_imu)
         if gnss is not None:
-            self._gnss_pub = node.create_publisher(messages.NavSatFix, topic("gps/fix"), _RELIABLE)
+            # The same fix on both names a GNSS consumer uses: robot_localization's (the fusion
+            # and GTSAM localizers, through sensors_node) and the fixed topic of the original
+            # GpsLocalizer, which is no parameter (without it that localizer never had a fix).
+            self._gnss_pubs = [
+                node.create_publisher(messages.NavSatFix, topic(name), _RELIABLE)
+                for name in ("gps/fix", "robot/gps/fix")
+            ]
             simulation.add_periodic(gnss.period, self.publish_gnss)
         simulation.on_scan.append(self.publish_scan)
         simulation.on_cloud.append(self.publish_cloud)
@@ -222,8 +228,10 @@ class RobotPort:
 
     def publish_gnss(self, stamp: float) -> None:
         robot = self.sim.robot
-        fix = self.gnss.fix(stamp, robot.x, robot.y)
-        self._gnss_pub.publish(messages.nav_sat_fix_msg(fix, self.frames["gnss_frame"]))
+        msg = messages.nav_sat_fix_msg(self.gnss.fix(stamp, robot.x, robot.y),
+                                       self.frames["gnss_frame"])
+        for publisher in self._gnss_pubs:
+            publisher.publish(msg)
 
     def publish_collision(self, collision: Collision) -> None:
         count = len(self.sim.checker.collisions)
