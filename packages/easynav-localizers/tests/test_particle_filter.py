@@ -199,6 +199,9 @@ def test_surface_cells_keep_the_faces_of_a_filled_block_and_whole_walls():
     assert block[:, :skin].all() and block[:, -skin:].all()
     assert not block[skin:-skin, skin:-skin].any()  # the inside a laser never reaches
     assert not (surface & ~grid.cells).any()
+    for bad in (-0.1, math.nan, math.inf):
+        with pytest.raises(ValueError, match="surface depth"):
+            surface_cells(grid, bad)
 
 
 def test_a_scan_that_lands_inside_a_filled_block_no_longer_fits():

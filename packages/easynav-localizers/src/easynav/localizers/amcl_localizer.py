@@ -86,17 +86,18 @@ class AMCLLocalizer(LocalizerMethodBase):
       :class:`ParticleFilter2D`), then ``robot_pose`` is written and ``map → odom`` broadcast.
     - Correction (``update``, non-RT thread): the ungrouped point perceptions, fused into the
       robot footprint frame, above z 0.1 m and downsampled to the map resolution, are scored
-      per particle by the fraction that hits occupied cells of ``map.base`` (a soft hit, see
-      ``hit_sigma`` and :func:`likelihood_field`); the weights are
+      per particle by the fraction that hits the obstacle surfaces of ``map.base`` (occupied
+      cells near free space, :func:`surface_cells`; a soft hit, see ``hit_sigma`` and
+      :func:`likelihood_field`); the weights are
       multiplied by it, the cloud is resampled (low variance) when its effective size drops
       below half, and every ``1/reseed_freq`` s the lower-weight half is redrawn around the
       upper half (at least ``min_noise_xy``/``min_noise_yaw`` apart).
 
     Parameters: :attr:`PARAMETERS` (defaults of the original). Added here: ``hit_sigma``
-    (0.2 m): a point ``d`` metres from the nearest occupied cell counts ``exp(-d²/2σ²)`` of a
-    hit; 0 counts only points on occupied cells, as the original did (it converges more slowly
-    and can lock onto a wrong pose). The noise, reseed and ``hit_sigma`` parameters can change at
-    runtime; the particle count and the initial pose are read at configure.
+    (0.2 m): a point ``d`` metres from the nearest obstacle surface counts ``exp(-d²/2σ²)`` of
+    a hit; 0 counts only points on the surfaces, as the original did on occupied cells (it
+    converges more slowly and can lock onto a wrong pose). The noise, reseed and ``hit_sigma``
+    parameters can change at runtime; the particle count and the initial pose are read at configure.
 
     NavState: reads ``map.base`` (:class:`SimpleMap`) and every ungrouped
     :class:`PointPerception`; writes ``robot_pose`` (:class:`Odometry` in the map frame, child

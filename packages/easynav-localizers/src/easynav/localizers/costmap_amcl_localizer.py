@@ -69,12 +69,13 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
     defaults: noise_* 0.01, initial std_dev 0.5, min_noise_* 0.05) and:
 
     - ``sensor_model``: ``hit_count`` (the original: the fraction of the scan points that land on
-      lethal (254) cells, hits and possible points accumulated across corrections until the next
-      reseed, weight = hits / possible) or ``likelihood_field`` (Nav2's: each point scores
+      lethal (254) cells, here the lethal cells near free space, :func:`surface_cells`; hits and
+      possible points accumulated across corrections until the next reseed, weight = hits /
+      possible) or ``likelihood_field`` (Nav2's: each point scores
       ``pz = z_hit·exp(-d²/2σ²) + z_rand/laser_max_range`` with ``d`` the distance to the nearest
-      lethal cell from an OpenCV distance transform, the weight is multiplied by ``1 + Σ pz³``,
-      the cloud is resampled when its effective size falls below half). Both score every
-      particle at once (:func:`hit_fractions`, vectorised over particles × points).
+      lethal surface cell from an exact distance transform, the weight is multiplied by
+      ``1 + Σ pz³``, the cloud is resampled when its effective size falls below half). Both
+      score every particle at once (:func:`hit_fractions`, vectorised over particles × points).
     - KLD-adaptive particle count (``kld_sampling``): at each resample (each reseed in the
       hit-count model, which does not resample otherwise) the cloud is resized to Fox's bound
       for ``pf_err``/``pf_z`` within ``[min_particles, max_particles]``.

@@ -34,8 +34,9 @@ SURFACE_DEPTH = 0.3
 
 def surface_cells(grid, depth: float = SURFACE_DEPTH) -> np.ndarray:
     """The obstacle cells a range sensor can hit: the :func:`occupied_cells` within ``depth``
-    metres (at least one cell, counted in 4-neighbour steps) of a cell that is not occupied
-    or of the map's edge. ``(height, width)`` bool.
+    metres (at least one cell) of a cell that is not occupied or of the map's edge, counted in
+    4-neighbour steps: exact along the grid's axes, about 0.7 of it across a diagonal wall.
+    ``(height, width)`` bool. Raises ValueError for a negative or non-finite ``depth``.
 
     Why not every occupied cell: a laser point lands on an obstacle's face, never inside it.
     A map that draws a building or a pillar as a filled block (drawn and CAD maps do; a SLAM
@@ -45,8 +46,10 @@ def surface_cells(grid, depth: float = SURFACE_DEPTH) -> np.ndarray:
     from a building's wall, the true pose's scan fitted worse than the pose 1.6 m closer,
     whose points fell inside the building (likelihood field 8.4 against 13.6; exact hits 41
     against 76 of 76 points), and AMCL kept a 1.9 m error. Walls of ordinary thickness are
-    unchanged.
+    unchanged (along the grid up to twice ``depth``).
     """
+    if not (math.isfinite(depth) and depth >= 0.0):
+        raise ValueError(f"surface depth = {depth} must be finite and >= 0")
     cells = occupied_cells(grid)
     steps = max(1, int(math.ceil(depth / float(grid.resolution) - 1e-9)))
     inside = cells
