@@ -157,8 +157,8 @@ def plugin_class(kind_name: str, name: str) -> type:
 
 
 def world_sensors(world: str) -> set[str]:
-    """The sensors a shipped world's robot has: a laser always; an IMU and a GNSS receiver
-    where the world declares them."""
+    """The sensors a shipped world's robot has: a laser always; an IMU, a GNSS receiver and a
+    3D lidar where the world declares them."""
     from easynav.playground.world_description import WorldDescription
 
     description = WorldDescription.resolve(world)
@@ -167,6 +167,8 @@ def world_sensors(world: str) -> set[str]:
         sensors.add("imu")
     if description.gnss is not None:
         sensors.add("gnss")
+    if description.robot is not None and description.robot.lidar is not None:
+        sensors.add("lidar")
     return sensors
 
 
@@ -358,6 +360,33 @@ def representative_sections() -> dict[str, dict]:
     return sections
 
 
+def maps_stack_sections() -> dict[frozenset, dict[str, dict]]:
+    """For each stack of two or more maps managers configured together in a params file (the
+    NavMap stack's NavMap and Bonxai walls): each one's section in the first file that has
+    that stack, files in the order of :func:`representative_sections`. A stack's members are
+    tuned for each other: the NavMap AMCL scores on Bonxai walls that its file keeps static
+    (``insert_perceptions: false``), where the Bonxai file's own section inserts the sensors'
+    points."""
+    found: dict[frozenset, dict[str, dict]] = {}
+    others = [p for p in sorted(PARAMS_DIR.glob("*.yaml")) if p.resolve() != BASE_PARAMS.resolve()]
+    for path in [BASE_PARAMS, *others]:
+        try:
+            document = load_ros_yaml(path.read_text())
+        except yaml.YAMLError:
+            continue
+        if not isinstance(document, dict):
+            continue
+        params = (document.get("maps_manager_node") or {}).get("ros__parameters") or {}
+        members = {}
+        for alias in params.get("map_types") or []:
+            section = params.get(alias)
+            if isinstance(section, dict) and "plugin" in section:
+                members[section["plugin"]] = copy.deepcopy(section)
+        if len(members) >= 2:
+            found.setdefault(frozenset(members), members)
+    return found
+
+
 def compose_params(combo: Combination, sections: dict[str, dict] | None = None) -> dict:
     """The params document of one combination: the playground's file with each axis replaced
     by the chosen plugin's representative section (alias ``matrix``); the heartbeat on, so the
@@ -371,9 +400,13 @@ def compose_params(combo: Combination, sections: dict[str, dict] | None = None) 
             params.pop(alias, None)
         aliases = [f"matrix{i or ''}" for i in range(len(plugins))]
         params[types_key] = aliases
+        stack = maps_stack_sections().get(frozenset(plugins)) if len(plugins) > 1 else None
         for alias, plugin in zip(aliases, plugins, strict=True):
             known = sections.get(plugin)
-            params[alias] = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
+            if stack is not None:
+                params[alias] = copy.deepcopy(stack[plugin])
+            else:
+                params[alias] = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
     _add_the_sensors_they_read(document, combo, sections)
     _read_the_robots_sensors(document)
     system = document.setdefault("system_node", {}).setdefault("ros__parameters", {})

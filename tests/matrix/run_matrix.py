@@ -104,8 +104,9 @@ def _interrupt(signum, frame) -> None:
 
 
 def _stopped_half_way(row: dict) -> bool:
-    """A mission stopped from outside (a signal) rather than ended: its row is not a result."""
-    return (row.get("exit_code", 0) < 0 or row.get("exit_code") == 130
+    """A mission stopped from outside (Ctrl-C, SIGTERM) rather than ended: its row is not a
+    result. A crash (another signal, an out-of-memory kill) is a result: a failure."""
+    return (row.get("exit_code") in (130, -signal.SIGINT, -signal.SIGTERM)
             or row.get("summary", {}).get("final_state") == "INTERRUPTED")
 
 
@@ -161,6 +162,7 @@ def main(argv: list[str]) -> int:
             print(f"in no combination: {name}: {reason}")
         return 0
 
+    findings = load_findings()  # a malformed file is refused now, not after hours of runs
     results_path = Path(args.results)
     results_path.parent.mkdir(parents=True, exist_ok=True)
     if args.fresh:
@@ -222,7 +224,8 @@ def main(argv: list[str]) -> int:
         "Written by `make matrix` (tests/matrix/run_matrix.py): every compatible combination of "
         "the installed maps managers, localizers, planners and controllers (compatibility as the "
         "plugins declare it) in each world, each a waypoint mission of the playground. CI runs "
-        "the slice that uses every plugin at least once (`--slice`).",
+        "the slice that uses every plugin at least once (`--slice`). A failed row says what a "
+        "user would notice first and, once looked into, why (tests/matrix/findings.yaml).",
         "",
         f"- date: {started:%Y-%m-%d %H:%M} UTC (rows of earlier parts come from {results_path.name}"
         f"); Python {platform.python_version()}; speed-up x{args.speed_up:g}; "
@@ -235,7 +238,7 @@ def main(argv: list[str]) -> int:
         + (", ".join(f"{key} ({n} rows)" for key, n in sorted(commits.items())) or "none yet"),
     ])
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.output).write_text(markdown(outcomes, header, unmatched, load_findings()))
+    Path(args.output).write_text(markdown(outcomes, header, unmatched, findings))
     print(f"wrote {args.output}")
     return 0 if len(outcomes) == len(combos) and all(o.green for o in outcomes) else 1
 

@@ -116,6 +116,36 @@ def test_a_localizer_gets_the_sensors_its_file_declares_where_the_robot_has_them
     assert indoors["sensors_node"]["ros__parameters"]["sensors"] == ["laser"]
 
 
+def test_two_maps_managers_side_by_side_only_where_a_plugin_needs_both():
+    from matrix import plugin_class
+
+    from easynav.core.plugins.compatibility import required_maps
+
+    pairs = [c for c in combinations(("home",)) if len(c.maps_managers) == 2
+             and not any(needed_maps(plugin_class("maps manager", m)) for m in c.maps_managers)]
+    assert pairs, "the NavMap AMCL (NavMap + Bonxai) is in no combination"
+    for combo in pairs:
+        needs_both = [name for kind, name in zip(("localizer", "planner", "controller"),
+                                                 combo.plugins[-3:], strict=True)
+                      if required_maps(plugin_class(kind, name))]
+        assert needs_both, combo.name
+    # Their sections come from the file that configures the pair: the walls stay static.
+    maps = compose_params(pairs[0])["maps_manager_node"]["ros__parameters"]
+    bonxai = next(maps[a] for a in maps["map_types"] if "Bonxai" in maps[a]["plugin"])
+    assert bonxai["insert_perceptions"] is False
+
+
+def test_only_a_mission_stopped_from_outside_is_not_kept():
+    from run_matrix import _stopped_half_way
+
+    assert _stopped_half_way({"exit_code": 130, "summary": {}})
+    assert _stopped_half_way({"exit_code": -15, "summary": {}})
+    assert _stopped_half_way({"exit_code": 1, "summary": {"final_state": "INTERRUPTED"}})
+    assert not _stopped_half_way({"exit_code": -9, "summary": {}})  # killed: out of memory?
+    assert not _stopped_half_way({"exit_code": -11, "summary": {}})  # a crash is a result
+    assert not _stopped_half_way({"exit_code": 1, "summary": {"final_state": "TIMEOUT"}})
+
+
 def test_a_failed_row_says_why_when_a_finding_explains_it():
     combo = Combination("m/M", "l/L", "p/P", "c/C", "campus")
     failed = Outcome(combo, 1, {"collisions": 1, "waypoints": 5, "reached": 3},
