@@ -284,13 +284,7 @@ def unmatched_plugins(combos: list[Combination]) -> dict[str, str]:
 def shipped_stacks() -> list[set[str]]:
     """The plugin sets of the shipped params files (params/): stacks known to be tuned."""
     stacks = []
-    for path in sorted(PARAMS_DIR.glob("*.yaml")):
-        try:
-            document = load_ros_yaml(path.read_text())
-        except yaml.YAMLError:
-            continue
-        if not isinstance(document, dict):
-            continue
+    for _, document in _params_documents():
         plugins = set()
         for node, types_key, _ in AXES:
             params = (document.get(node) or {}).get("ros__parameters") or {}
@@ -332,6 +326,19 @@ def covering_slice(combos: list[Combination]) -> list[Combination]:
     return chosen
 
 
+def _params_documents():
+    """``(path, document)`` of each readable params file: the playground's own file first (the
+    base of every combination, tuned for the indoor worlds), then params/ in name order."""
+    others = [p for p in sorted(PARAMS_DIR.glob("*.yaml")) if p.resolve() != BASE_PARAMS.resolve()]
+    for path in [BASE_PARAMS, *others]:
+        try:
+            document = load_ros_yaml(path.read_text())
+        except yaml.YAMLError:
+            continue
+        if isinstance(document, dict):
+            yield path, document
+
+
 def representative_sections() -> dict[str, dict]:
     """For each plugin name, its configuration in the first params file that uses it (alias
     section, plus the node-level parameters of that node in that file): the playground's own
@@ -339,14 +346,7 @@ def representative_sections() -> dict[str, dict]:
     under params/ in name order. (Name order alone once took SimplePlanner from the campus
     file: 1 m of clearance outdoors, and the home tour's kitchen goal was refused.)"""
     sections: dict[str, dict] = {}
-    others = [p for p in sorted(PARAMS_DIR.glob("*.yaml")) if p.resolve() != BASE_PARAMS.resolve()]
-    for path in [BASE_PARAMS, *others]:
-        try:
-            document = load_ros_yaml(path.read_text())
-        except yaml.YAMLError:
-            continue
-        if not isinstance(document, dict):
-            continue
+    for path, document in _params_documents():
         for node, types_key, _ in AXES:
             params = (document.get(node) or {}).get("ros__parameters") or {}
             for alias in params.get(types_key) or []:
@@ -368,14 +368,7 @@ def maps_stack_sections() -> dict[frozenset, dict[str, dict]]:
     (``insert_perceptions: false``), where the Bonxai file's own section inserts the sensors'
     points."""
     found: dict[frozenset, dict[str, dict]] = {}
-    others = [p for p in sorted(PARAMS_DIR.glob("*.yaml")) if p.resolve() != BASE_PARAMS.resolve()]
-    for path in [BASE_PARAMS, *others]:
-        try:
-            document = load_ros_yaml(path.read_text())
-        except yaml.YAMLError:
-            continue
-        if not isinstance(document, dict):
-            continue
+    for _, document in _params_documents():
         params = (document.get("maps_manager_node") or {}).get("ros__parameters") or {}
         members = {}
         for alias in params.get("map_types") or []:
