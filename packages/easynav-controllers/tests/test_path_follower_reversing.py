@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from easynav.controllers import ARRIVED, SimplePathFollower
-from easynav.controllers.path_follower import path_segments
+from easynav.controllers.path_follower import motion_reversals, path_segments
 from easynav.core.robot import RobotLimits
 
 LIMITS = replace(RobotLimits(), min_linear_vel=-0.3)
@@ -58,6 +58,44 @@ def test_segments_are_cut_at_cusps():
     # A repeated pose keeps the direction of the step before it.
     doubled = np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0]])
     assert path_segments(doubled) == [(0, 3, 1)]
+
+
+def test_motion_reversals_cut_where_the_path_turns_back_whatever_the_yaw():
+    path = forward_then_reverse_arc()
+    cusp = len(straight(0.0, 1.5)) - 1
+    assert motion_reversals(path[:, :2]) == [(0, cusp, 1), (cusp, len(path) - 1, 1)]
+    # A right angle is a corner, not a cusp; a repeated pose is skipped.
+    corner = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    assert motion_reversals(corner) == [(0, 3, 1)]
+    hairpin = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 0.1]])
+    assert motion_reversals(hairpin) == [(0, 2, 1), (2, 3, 1)]
+    assert motion_reversals(np.zeros((1, 2))) == [(0, 0, 1)]
+
+
+@pytest.mark.parametrize("estimate_noise", [0.0, 0.01])
+def test_a_robot_that_does_not_reverse_turns_round_at_a_cusp(estimate_noise):
+    # Followed as one path, the carrot 0.2 m past the projection folds back from the cusp onto
+    # a robot 0.1 m short of it: the heading to it is noise and the robot turned on the spot
+    # there for minutes (an OMPL Reeds-Shepp run in the depot). Cut at the cusp, it drives to
+    # the cusp, turns round and drives the rest forward.
+    path = forward_then_reverse_arc()
+    follower = SimplePathFollower(look_ahead_dist=0.2)
+    rng = np.random.default_rng(3)
+    x, y, yaw = 0.0, 0.0, 0.0
+    dt, limits = 1 / 30, RobotLimits()
+    trace = []
+    for _ in range(int(60.0 / dt)):
+        estimate = (x, y, yaw) + rng.normal(0.0, estimate_noise, 3)
+        v, w, state = follower.compute(estimate, path, dt, limits)
+        trace.append((x, y, v))
+        if state == ARRIVED:
+            break
+        x, y, yaw = x + v * math.cos(yaw) * dt, y + v * math.sin(yaw) * dt, yaw + w * dt
+    assert state == ARRIVED
+    trace = np.array(trace)
+    assert (trace[:, 2] >= 0.0).all()
+    assert np.hypot(trace[:, 0] - 1.5, trace[:, 1]).min() <= 0.1 + 0.01  # went to the cusp
+    assert math.hypot(x - path[-1, 0], y - path[-1, 1]) <= 0.05 + 3 * estimate_noise
 
 
 def test_a_goal_behind_is_reached_backing_up_without_turning_around():

@@ -70,6 +70,33 @@ def path_segments(path_xy_yaw: np.ndarray) -> list[tuple[int, int, int]]:
     return segments
 
 
+def motion_reversals(path_xy: np.ndarray) -> list[tuple[int, int, int]]:
+    """The path cut where its motion turns back on itself: ``(first, last, 1)`` index ranges
+    (inclusive), a cut at every pose whose step in and step out make an angle over 90 degrees
+    (a cusp of a Reeds–Shepp path, whatever its poses' yaw says). Zero-length steps are skipped.
+
+    A robot that cannot reverse drives these pieces one after the other, forward, turning round
+    at each cut: followed as one path, the carrot past a cusp folds back onto the robot, whose
+    heading to it is then noise (it turned on the spot for minutes, 0.1 m short of a cusp).
+    """
+    path = np.asarray(path_xy, dtype=float)
+    if len(path) < 3:
+        return [(0, max(len(path) - 1, 0), 1)]
+    segments = []
+    first = 0
+    previous: np.ndarray | None = None
+    for i in range(len(path) - 1):
+        step = path[i + 1, :2] - path[i, :2]
+        if not np.hypot(step[0], step[1]) > 1e-9:
+            continue
+        if previous is not None and float(np.dot(previous, step)) < 0.0:
+            segments.append((first, i, 1))
+            first = i
+        previous = step
+    segments.append((first, len(path) - 1, 1))
+    return segments
+
+
 def _limit_change(
     target: float, previous: float, speed_up: float, slow_down: float, dt: float
 ) -> float:
@@ -94,12 +121,14 @@ class SimplePathFollower:
     clamped to the robot limits and changed within their accelerations (speeding up) and
     decelerations (slowing down).
 
-    With ``allow_reversing`` (off by default) a path is cut at its cusps (:func:`path_segments`)
-    and followed one segment at a time: a segment whose poses face away from the direction of
-    travel (a Reeds–Shepp reverse) is driven backwards, the robot's back towards the carrot
-    (``v`` < 0, within ``min_linear_vel``), and the next segment starts once the robot is within
-    ``cusp_tolerance`` of the cusp. A robot whose limits forbid reversing (``min_linear_vel`` 0)
-    drives every segment forward.
+    A path is followed one piece at a time, cut at its cusps; the next piece starts once the
+    robot is within ``cusp_tolerance`` of the cusp. Without ``allow_reversing`` (the default) the
+    cuts are where the motion turns back on itself (:func:`motion_reversals`) and the robot
+    drives every piece forward, turning round at each cusp. With ``allow_reversing`` the cuts
+    are where the poses' yaw changes from facing the motion to facing away from it
+    (:func:`path_segments`): a piece whose poses face away (a Reeds–Shepp reverse) is driven
+    backwards, the robot's back towards the carrot (``v`` < 0, within ``min_linear_vel``). A robot
+    whose limits forbid reversing (``min_linear_vel`` 0) drives every piece forward.
 
     Thread contract: owned by the controller plugin, RT thread only; not locked.
     Exceptions: :class:`ValueError` for parameters out of range (naming them).
@@ -140,7 +169,7 @@ class SimplePathFollower:
         self._goal: tuple[float, float, float] | None = None
         self._final_rotation = False
         self._state = NO_PATH
-        # Reversing: the path being followed (its identity), its segments, the current one.
+        # The path being followed (its identity), its pieces between cusps, the current one.
         self._segments_of: np.ndarray | None = None
         self._segments: list[tuple[int, int, int]] = []
         self._segment = 0
@@ -166,7 +195,9 @@ class SimplePathFollower:
             or (self._segments_of.shape == path.shape and np.array_equal(self._segments_of, path))
         ):
             self._segments_of = path
-            self._segments = path_segments(path)
+            self._segments = (
+                path_segments(path) if self.allow_reversing else motion_reversals(path[:, :2])
+            )
             self._segment = 0
         # Past a cusp once the robot is close enough to it (never back: the path may pass the
         # same place in both directions).
@@ -219,13 +250,11 @@ class SimplePathFollower:
         dist_goal = math.hypot(goal[0] - x, goal[1] - y)
         yaw_error = normalize_angle(goal[2] - yaw)
 
-        piece, direction, on_last = path, 1, True
-        if self.allow_reversing:
-            piece, direction = self._active_segment(path, x, y)
-            # A path with cusps may pass the goal before its last segment: not arrived there.
-            on_last = self._segment == len(self._segments) - 1
-            if limits.min_linear_vel >= 0.0:
-                direction = 1  # this robot cannot reverse: drive the segment forward
+        piece, direction = self._active_segment(path, x, y)
+        # A path with cusps may pass the goal before its last segment: not arrived there.
+        on_last = self._segment == len(self._segments) - 1
+        if not self.allow_reversing or limits.min_linear_vel >= 0.0:
+            direction = 1  # this robot does not reverse: drive the segment forward
 
         if on_last and (
             dist_goal <= stop_dist or (self._final_rotation and dist_goal <= 2.0 * stop_dist)
