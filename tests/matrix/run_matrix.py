@@ -7,10 +7,12 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --jobs N   N missions at once, each in a process of its own (a mission takes about a core
              at x1: N above the number of cores slows every run and can fail them)
   --results  where each finished run is kept, one JSON line per run (default
-             build/matrix/results.jsonl). A later call skips the combinations already there,
-             so the full matrix (hundreds of missions, many hours) can run in parts: stop it
-             at any time (Ctrl-C or SIGTERM: runs in progress finish and are kept, queued
-             ones do not start) and start it again. docs/matrix.md is written from the file.
+             docs/matrix.results.jsonl, kept in the repository with docs/matrix.md). A later
+             call skips the combinations already there, so the full matrix (a thousand
+             missions, more than a day of a 2-core machine) runs in parts, on any machine
+             with a clone: stop it at any time (Ctrl-C or SIGTERM: runs in progress finish
+             and are kept, queued ones do not start), commit the file, start it again.
+             docs/matrix.md is written from the file; each row names the commit it ran.
   --fresh    forget the results file first
   --only S   only the combinations whose name contains one of the comma-separated S
   --list     print the combinations and exit
@@ -51,7 +53,7 @@ from matrix import (  # noqa: E402 (the folder is not a package)
     unmatched_plugins,
 )
 
-DEFAULT_RESULTS = ROOT / "build" / "matrix" / "results.jsonl"
+DEFAULT_RESULTS = ROOT / "docs" / "matrix.results.jsonl"
 
 
 def load_results(path: Path) -> dict[str, dict]:
@@ -77,9 +79,9 @@ def source_commit() -> str:
         return done.stdout.strip() if done.returncode == 0 else ""
 
     commit = git("rev-parse", "--short", "HEAD") or "unknown"
-    # docs/matrix.md is this runner's own output, not code the runs use.
+    # docs/matrix.md and the results file are this runner's own output, not code the runs use.
     changed = git("status", "--porcelain", "--untracked-files=no", "--", ".",
-                  ":(exclude)docs/matrix.md")
+                  ":(exclude)docs/matrix.md", ":(exclude)docs/matrix.results.jsonl")
     return commit + ("+changes" if changed else "")
 
 
@@ -184,6 +186,7 @@ def main(argv: list[str]) -> int:
         row = _run_in_process(combo.name, work / f"{i:03d}", args)
         row["seconds"] = round(time.monotonic() - t0, 1)
         row["commit"] = commit
+        run_dir = row.pop("run_dir", "")  # a temporary folder: not kept in the row
         if _stopped_half_way(row):  # a mission killed on its own is no result: run it again
             print(f"[-] {combo.name}: stopped before its end ({row['error']}), not kept",
                   flush=True)
@@ -194,7 +197,7 @@ def main(argv: list[str]) -> int:
             kept[combo.name] = row
             finished[0] += 1
             green = row["exit_code"] == 0 and row["summary"].get("success")
-            verdict = "green" if green else f"FAILED ({row['error']})"
+            verdict = "green" if green else f"FAILED ({row['error']}; the run: {run_dir})"
             print(f"[{finished[0]}/{len(todo)}] {combo.name}: {verdict} ({row['seconds']:.0f} s)",
                   flush=True)
 
