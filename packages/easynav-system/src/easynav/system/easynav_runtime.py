@@ -11,43 +11,16 @@ import time
 from dataclasses import dataclass
 
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 
 from easynav.core.nav_state import NavState
 from easynav.system.cycle_loop import CycleLoop
+from easynav.system.executor import EXECUTOR_ENV, make_executor  # noqa: F401 (re-exported)
 from easynav.system.process_tuning import tune_malloc
 from easynav.system.system_node import SystemNode
 
 #: SCHED_FIFO priority of the non-RT loop with ``use_real_time``: below the RT loop's 80.
 NORT_PRIORITY = 70
-
-#: ``EASYNAV_EXECUTOR=single``: rclpy's SingleThreadedExecutor instead of its EventsExecutor.
-EXECUTOR_ENV = "EASYNAV_EXECUTOR"
-
-
-def make_executor(context: rclpy.Context):
-    """The executor of one loop: rclpy's EventsExecutor (``rclpy.experimental``, C++), else its
-    SingleThreadedExecutor (an rclpy without it, or ``EASYNAV_EXECUTOR=single``).
-
-    Why (issue #21): the SingleThreadedExecutor builds a new wait set in Python at every
-    ``spin_once`` (every entity of every node: 72 services and 16-41 QoS event handlers for the
-    non-RT loop's six lifecycle nodes), 0.3-1 ms each, and the loops call it at least once per
-    cycle (200 Hz each): measured with ``easynav demo`` (home, simple stack) on an idle machine,
-    ``easynav run`` 37 % of a core with it, 14 % with the EventsExecutor, which keeps its
-    entities between calls and is woken by the middleware's events. Same loops, same rates,
-    same callbacks in the same threads; the RT loop's timing (bench_rt_loop.py) meets its goal
-    with both.
-    """
-    if os.environ.get(EXECUTOR_ENV, "").strip().lower() != "single":
-        try:
-            from rclpy.experimental import EventsExecutor
-        except ImportError:
-            pass
-        else:
-            return EventsExecutor(context=context)
-    return SingleThreadedExecutor(context=context)
-
 
 @dataclass
 class RuntimeResult:

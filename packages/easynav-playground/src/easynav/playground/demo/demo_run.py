@@ -129,7 +129,8 @@ class DemoRun:
 
     def _open_ros(self) -> None:
         import rclpy
-        from rclpy.executors import SingleThreadedExecutor
+
+        from easynav.system.executor import make_executor
 
         self.context = rclpy.Context()
         # This process's participant discovers on this host only, like its children's.
@@ -142,7 +143,7 @@ class DemoRun:
                 os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
             else:
                 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = saved_range
-        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor = make_executor(self.context)
 
     def _start(self) -> None:
         from easynav.playground.demo.run_monitor import RunMonitor

@@ -249,10 +249,10 @@ def run_fleet_demo(
 def _run(description, runs, children, domain, record, output_png, timeout, ready_timeout,
          out) -> int:
     import rclpy
-    from rclpy.executors import SingleThreadedExecutor
 
     from easynav.core.types import Header, Pose, PoseStamped
     from easynav.playground.demo.run_monitor import RunMonitor
+    from easynav.system.executor import make_executor
     from easynav.system.goals.goal_client_state import GoalClientState as S
     from easynav.system.goals.goal_manager_client import GoalManagerClient
 
@@ -266,7 +266,7 @@ def _run(description, runs, children, domain, record, output_png, timeout, ready
             os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
         else:
             os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = saved_range
-    executor = SingleThreadedExecutor(context=context)
+    executor = make_executor(context)
     progress = ProgressLine(out)
     watch = TopicWatch()
     names = [r.name for r in runs]

@@ -72,10 +72,10 @@ def main(argv: list[str] | None = None) -> int:
     destroy the node, ``rclpy.shutdown()`` (the other order aborts the interpreter).
     """
     import rclpy
-    from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
 
     from easynav.playground.ros.playground_node import PlaygroundNode
+    from easynav.system.executor import make_executor
 
     argv = list(sys.argv[1:] if argv is None else argv)
     ros_args: list[str] = []
@@ -107,7 +107,7 @@ def main(argv: list[str] | None = None) -> int:
     previous = {
         sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)
     }
-    executor = SingleThreadedExecutor()
+    executor = make_executor()
     node = None
     code = 0
     try:
