@@ -21,6 +21,7 @@ import io
 import itertools
 import json
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -326,27 +327,44 @@ def covering_slice(combos: list[Combination]) -> list[Combination]:
     return chosen
 
 
-def _params_documents():
-    """``(path, document)`` of each readable params file: the playground's own file first (the
-    base of every combination, tuned for the indoor worlds), then params/ in name order."""
+#: The world a params file was written for: its "Run: easynav demo --world NAME" line.
+_RUN_WORLD = re.compile(r"--world\s+(\w+)")
+
+
+def params_world(text: str) -> str | None:
+    """The world a params file's text names in its ``--world NAME`` run line (None: none, the
+    demo's default world)."""
+    match = _RUN_WORLD.search(text)
+    return match.group(1) if match else None
+
+
+def _params_documents(world: str | None = None):
+    """``(path, document)`` of each readable params file: those written for ``world`` (their
+    run line names it) first, then the playground's own file (the base of every combination,
+    tuned for the indoor worlds), then params/ in name order."""
     others = [p for p in sorted(PARAMS_DIR.glob("*.yaml")) if p.resolve() != BASE_PARAMS.resolve()]
-    for path in [BASE_PARAMS, *others]:
+    paths = [BASE_PARAMS, *others]
+    texts = {path: path.read_text() for path in paths}
+    if world is not None:
+        paths.sort(key=lambda path: params_world(texts[path]) != world)  # stable
+    for path in paths:
         try:
-            document = load_ros_yaml(path.read_text())
+            document = load_ros_yaml(texts[path])
         except yaml.YAMLError:
             continue
         if isinstance(document, dict):
             yield path, document
 
 
-def representative_sections() -> dict[str, dict]:
-    """For each plugin name, its configuration in the first params file that uses it (alias
-    section, plus the node-level parameters of that node in that file): the playground's own
-    file first (the base of every combination, tuned for the indoor worlds), then the files
-    under params/ in name order. (Name order alone once took SimplePlanner from the campus
-    file: 1 m of clearance outdoors, and the home tour's kitchen goal was refused.)"""
+def representative_sections(world: str | None = None) -> dict[str, dict]:
+    """For each plugin name, its configuration (alias section) in the first params file that
+    uses it: a file written for ``world`` first, then the playground's own file (the base of
+    every combination, tuned for the indoor worlds), then the files under params/ in name
+    order. (Name order alone once took SimplePlanner from the campus file for every world: 1 m
+    of clearance indoors, and the home tour's kitchen goal was refused. The indoor section in
+    the campus, 0.2 m, let a robot placed by GNSS alone clip a building's corner.)"""
     sections: dict[str, dict] = {}
-    for path, document in _params_documents():
+    for path, document in _params_documents(world):
         for node, types_key, _ in AXES:
             params = (document.get(node) or {}).get("ros__parameters") or {}
             for alias in params.get(types_key) or []:
@@ -384,7 +402,7 @@ def compose_params(combo: Combination, sections: dict[str, dict] | None = None) 
     """The params document of one combination: the playground's file with each axis replaced
     by the chosen plugin's representative section (alias ``matrix``); the heartbeat on, so the
     run reports late RT cycles."""
-    sections = representative_sections() if sections is None else sections
+    sections = representative_sections(combo.world) if sections is None else sections
     document = load_ros_yaml(BASE_PARAMS.read_text())
     chosen = (combo.maps_managers, (combo.localizer,), (combo.planner,), (combo.controller,))
     for (node, types_key, _), plugins in zip(AXES, chosen, strict=True):

@@ -21,6 +21,7 @@ from matrix import (
     load_findings,
     markdown,
     navigation_plugins,
+    params_world,
     representative_sections,
     run_combination,
     unmatched_plugins,
@@ -80,6 +81,21 @@ def test_composed_params_take_each_plugin_from_its_representative_file():
             assert params["matrix"] == expected
     heartbeat = document["system_node"]["ros__parameters"]["safety"]["heartbeat"]
     assert heartbeat["period"] > 0
+
+
+def test_each_world_takes_a_plugin_from_a_file_written_for_it_first():
+    assert params_world("# Run: easynav demo --world campus --params p.yaml\n") == "campus"
+    assert params_world("# Run: `easynav demo --params p.yaml` (or --world <world>).") is None
+    planner = "easynav_simple_planner/SimplePlanner"
+    combo = next(c for c in combinations(("campus",)) if c.planner == planner)
+
+    def clearance(world):
+        document = compose_params(dataclasses.replace(combo, world=world))
+        return document["planner_node"]["ros__parameters"]["matrix"]["clearance_distance"]
+
+    # The campus files keep paths a metre off the buildings; indoors, the playground's 0.2 m.
+    assert clearance("campus") == 1.0
+    assert clearance("home") == 0.2
 
 
 def test_a_maps_manager_reading_a_sensor_group_the_robot_lacks_reads_its_laser():
