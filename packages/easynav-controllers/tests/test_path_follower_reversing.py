@@ -1,4 +1,5 @@
-"""The path follower's reversing mode (allow_reversing) on a simulated unicycle."""
+"""The path follower at cusps, on a simulated unicycle: turning round at them (the default) and
+reversing through them (allow_reversing)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 from easynav.controllers import ARRIVED, SimplePathFollower
-from easynav.controllers.path_follower import motion_reversals, path_segments
+from easynav.controllers.path_follower import cusp_pieces, path_segments
 from easynav.core.robot import RobotLimits
 
 LIMITS = replace(RobotLimits(), min_linear_vel=-0.3)
@@ -60,16 +61,17 @@ def test_segments_are_cut_at_cusps():
     assert path_segments(doubled) == [(0, 3, 1)]
 
 
-def test_motion_reversals_cut_where_the_path_turns_back_whatever_the_yaw():
+def test_cusp_pieces_cut_where_the_path_turns_back_whatever_the_yaw():
     path = forward_then_reverse_arc()
     cusp = len(straight(0.0, 1.5)) - 1
-    assert motion_reversals(path[:, :2]) == [(0, cusp, 1), (cusp, len(path) - 1, 1)]
-    # A right angle is a corner, not a cusp; a repeated pose is skipped.
+    assert cusp_pieces(path[:, :2]) == [(0, cusp, 1), (cusp, len(path) - 1, 1)]
+    # A right angle is a corner, not a cusp; a repeated pose is skipped; a turn sharper than a
+    # right angle is a cusp (Nav2's rule).
     corner = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
-    assert motion_reversals(corner) == [(0, 3, 1)]
+    assert cusp_pieces(corner) == [(0, 3, 1)]
     hairpin = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 0.1]])
-    assert motion_reversals(hairpin) == [(0, 2, 1), (2, 3, 1)]
-    assert motion_reversals(np.zeros((1, 2))) == [(0, 0, 1)]
+    assert cusp_pieces(hairpin) == [(0, 2, 1), (2, 3, 1)]
+    assert cusp_pieces(np.zeros((1, 2))) == [(0, 0, 1)]
 
 
 @pytest.mark.parametrize("estimate_noise", [0.0, 0.01])
@@ -96,6 +98,59 @@ def test_a_robot_that_does_not_reverse_turns_round_at_a_cusp(estimate_noise):
     assert (trace[:, 2] >= 0.0).all()
     assert np.hypot(trace[:, 0] - 1.5, trace[:, 1]).min() <= 0.1 + 0.01  # went to the cusp
     assert math.hypot(x - path[-1, 0], y - path[-1, 1]) <= 0.05 + 3 * estimate_noise
+
+
+def drive(follower, path, start, seconds=60.0, reset_at=None):
+    """The unicycle driven by ``follower``, ``reset()`` once when the robot first comes within
+    0.1 m of ``reset_at``: the trace of (x, y, v), whether it arrived, the step of the reset."""
+    x, y, yaw = start
+    dt, limits = 1 / 30, RobotLimits()
+    trace, reset_step = [], None
+    for step in range(int(seconds / dt)):
+        if reset_step is None and reset_at is not None and (
+            math.hypot(x - reset_at[0], y - reset_at[1]) < 0.1
+        ):
+            follower.reset()
+            reset_step = step
+        v, w, state = follower.compute((x, y, yaw), path, dt, limits)
+        trace.append((x, y, v))
+        if state == ARRIVED:
+            return np.array(trace), True, reset_step
+        x, y, yaw = x + v * math.cos(yaw) * dt, y + v * math.sin(yaw) * dt, yaw + w * dt
+    return np.array(trace), False, reset_step
+
+
+def test_a_reset_past_a_cusp_does_not_send_the_robot_back_to_it():
+    # A reset (a missed pose, a clock hiccup) keeps the piece the robot is on: the same path
+    # goes on from there, not from the cusp it already turned round at.
+    path = forward_then_reverse_arc()
+    cusp = len(straight(0.0, 1.5)) - 1
+    follower = SimplePathFollower(look_ahead_dist=0.2)
+    trace, arrived, reset_step = drive(follower, path, (0.0, 0.0, 0.0),
+                                       reset_at=path[cusp + 15, :2])
+    assert arrived and reset_step is not None
+    assert np.hypot(trace[reset_step:, 0] - 1.5, trace[reset_step:, 1]).min() > 0.3
+
+
+def test_a_new_follower_starts_at_the_piece_nearest_the_robot():
+    path = forward_then_reverse_arc()
+    follower = SimplePathFollower(look_ahead_dist=0.2)
+    follower.compute((0.5, 0.95, -1.4), path, 0.1, RobotLimits())  # near the end of the arc
+    assert follower._segment == 1
+    follower = SimplePathFollower(look_ahead_dist=0.2)
+    follower.compute((0.3, 0.0, 0.0), path, 0.1, RobotLimits())  # on the first leg
+    assert follower._segment == 0
+
+
+def test_a_robot_beyond_a_cusp_goes_on_though_it_never_came_within_the_tolerance():
+    # Overshooting a cusp sideways (0.15 m off, beyond the 0.1 m tolerance), the robot is past
+    # it along the piece's last step: the next piece starts.
+    path = forward_then_reverse_arc()
+    follower = SimplePathFollower(look_ahead_dist=0.2)
+    follower.compute((1.0, 0.0, 0.0), path, 0.1, RobotLimits())
+    assert follower._segment == 0
+    follower.compute((1.52, -0.15, 0.0), path, 0.1, RobotLimits())
+    assert follower._segment == 1
 
 
 def test_a_goal_behind_is_reached_backing_up_without_turning_around():
@@ -152,6 +207,9 @@ def test_a_new_path_starts_again_from_its_first_segment():
 def test_cusp_tolerance_is_checked():
     with pytest.raises(ValueError, match="cusp_tolerance = -1"):
         SimplePathFollower(cusp_tolerance=-1.0)
+    # 0 is never reached: the speed towards the cusp falls with the distance to it.
+    with pytest.raises(ValueError, match="cusp_tolerance = 0.0 must be finite and > 0"):
+        SimplePathFollower(cusp_tolerance=0.0)
 
 
 def test_the_simple_controller_passes_the_parameters_to_its_follower():

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from easynav.controllers.pid_controller import PIDController
+from easynav.controllers.regulated_pp.path_geometry import cusp_indices, project_on_path
 from easynav.core.robot import RobotLimits
 from easynav.core.types import normalize_angle
 
@@ -70,31 +71,20 @@ def path_segments(path_xy_yaw: np.ndarray) -> list[tuple[int, int, int]]:
     return segments
 
 
-def motion_reversals(path_xy: np.ndarray) -> list[tuple[int, int, int]]:
-    """The path cut where its motion turns back on itself: ``(first, last, 1)`` index ranges
-    (inclusive), a cut at every pose whose step in and step out make an angle over 90 degrees
-    (a cusp of a Reeds–Shepp path, whatever its poses' yaw says). Zero-length steps are skipped.
+def cusp_pieces(path_xy: np.ndarray) -> list[tuple[int, int, int]]:
+    """The path cut at its cusps, whatever its poses' yaw: ``(first, last, 1)`` index ranges
+    (inclusive, shaped as :func:`path_segments`'), cut at every pose where the motion turns back,
+    the step in and the step out more than a right angle apart (a Reeds–Shepp cusp; Nav2's rule,
+    as :func:`~easynav.controllers.regulated_pp.path_geometry.cusp_indices`, so a hairpin
+    sharper than a right angle is cut too). Zero-length steps have no direction and are skipped.
 
-    A robot that cannot reverse drives these pieces one after the other, forward, turning round
-    at each cut: followed as one path, the carrot past a cusp folds back onto the robot, whose
-    heading to it is then noise (it turned on the spot for minutes, 0.1 m short of a cusp).
+    A robot that does not reverse drives these pieces one after the other, forward, turning
+    round at each cut: followed as one path, the carrot past a cusp folds back onto the robot,
+    whose heading to it is then noise (it turned on the spot for minutes, 0.1 m short of a cusp).
     """
-    path = np.asarray(path_xy, dtype=float)
-    if len(path) < 3:
-        return [(0, max(len(path) - 1, 0), 1)]
-    segments = []
-    first = 0
-    previous: np.ndarray | None = None
-    for i in range(len(path) - 1):
-        step = path[i + 1, :2] - path[i, :2]
-        if not np.hypot(step[0], step[1]) > 1e-9:
-            continue
-        if previous is not None and float(np.dot(previous, step)) < 0.0:
-            segments.append((first, i, 1))
-            first = i
-        previous = step
-    segments.append((first, len(path) - 1, 1))
-    return segments
+    cuts = [int(i) for i in cusp_indices(np.asarray(path_xy, dtype=float)[:, :2])]
+    bounds = [0, *cuts, max(len(path_xy) - 1, 0)]
+    return [(first, last, 1) for first, last in zip(bounds[:-1], bounds[1:], strict=True)]
 
 
 def _limit_change(
@@ -123,7 +113,7 @@ class SimplePathFollower:
 
     A path is followed one piece at a time, cut at its cusps; the next piece starts once the
     robot is within ``cusp_tolerance`` of the cusp. Without ``allow_reversing`` (the default) the
-    cuts are where the motion turns back on itself (:func:`motion_reversals`) and the robot
+    cuts are where the motion turns back on itself (:func:`cusp_pieces`) and the robot
     drives every piece forward, turning round at each cusp. With ``allow_reversing`` the cuts
     are where the poses' yaw changes from facing the motion to facing away from it
     (:func:`path_segments`): a piece whose poses face away (a Reeds–Shepp reverse) is driven
@@ -150,10 +140,12 @@ class SimplePathFollower:
             ("tolerance_dist", tolerance_dist),
             ("final_goal_angle_tolerance", final_goal_angle_tolerance),
             ("k_rot", k_rot),
-            ("cusp_tolerance", cusp_tolerance),
         ):
             if not math.isfinite(value) or value < 0.0:
                 raise ValueError(f"{name} = {value} must be finite and >= 0")
+        # 0 would never be reached: the speed to the cusp falls with the distance to it.
+        if not math.isfinite(cusp_tolerance) or cusp_tolerance <= 0.0:
+            raise ValueError(f"cusp_tolerance = {cusp_tolerance} must be finite and > 0")
         self.look_ahead_dist = float(look_ahead_dist)
         self.tolerance_dist = float(tolerance_dist)
         self.final_goal_angle_tolerance = float(final_goal_angle_tolerance)
@@ -175,13 +167,17 @@ class SimplePathFollower:
         self._segment = 0
 
     def reset(self) -> None:
-        """Forget the PID state, the last command and the final-rotation mode."""
+        """Forget the PID state, the last command and the final-rotation mode. The piece of the
+        path the robot is on is kept: the same path after a reset (a missed pose, a parameter
+        changed) goes on from there, not from a cusp already passed."""
         self.linear_pid.reset()
         self.angular_pid.reset()
         self._v = self._w = 0.0
         self._goal = None
         self._final_rotation = False
         self._state = NO_PATH
+
+    def _forget_path(self) -> None:
         self._segments_of = None
         self._segments = []
         self._segment = 0
@@ -196,15 +192,27 @@ class SimplePathFollower:
         ):
             self._segments_of = path
             self._segments = (
-                path_segments(path) if self.allow_reversing else motion_reversals(path[:, :2])
+                path_segments(path) if self.allow_reversing else cusp_pieces(path[:, :2])
             )
-            self._segment = 0
-        # Past a cusp once the robot is close enough to it (never back: the path may pass the
-        # same place in both directions).
+            # A new plan starts at the robot (the first piece); a path already part-driven (a
+            # new follower after a parameter change) at the piece nearest the robot, the
+            # earliest of equals (a Reeds–Shepp path may come back over itself).
+            nearest, _, _ = project_on_path(path[:, :2], np.array((x, y)), 0, len(path) - 1)
+            self._segment = next(
+                (k for k, (first, last, _) in enumerate(self._segments) if nearest < last), 0
+            )
+        # Past a cusp once the robot is close enough to it, or beyond it along the piece's last
+        # step (never back: the path may pass the same place in both directions).
         while self._segment < len(self._segments) - 1:
-            last = self._segments[self._segment][1]
-            if math.hypot(path[last, 0] - x, path[last, 1] - y) > self.cusp_tolerance:
-                break
+            first, last, _ = self._segments[self._segment]
+            to_robot = (x - path[last, 0], y - path[last, 1])
+            if math.hypot(*to_robot) > self.cusp_tolerance:
+                moving = np.flatnonzero(np.any(np.diff(path[first : last + 1, :2], axis=0), axis=1))
+                if len(moving) == 0:
+                    break
+                step = path[first + moving[-1] + 1, :2] - path[first + moving[-1], :2]
+                if to_robot[0] * step[0] + to_robot[1] * step[1] < 0.0:
+                    break  # still short of the cusp
             self._segment += 1
         first, last, direction = self._segments[self._segment]
         return path[first : last + 1], direction
@@ -228,6 +236,7 @@ class SimplePathFollower:
         path = np.asarray(path_xy_yaw, dtype=float)
         if path.ndim != 2 or len(path) == 0:
             self.reset()
+            self._forget_path()
             return 0.0, 0.0, NO_PATH
         if not dt > 0.0:
             # No time has passed (several runs within one tick of a simulated clock): the PIDs

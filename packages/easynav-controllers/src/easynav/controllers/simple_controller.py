@@ -62,7 +62,7 @@ class SimpleController(ControllerMethodBase):
               "Reeds-Shepp path) in reverse, within robot_limits.min_linear_vel. Not in the "
               "original"),
         Param("cusp_tolerance", 0.1, "distance to a cusp at which the next segment starts", "m",
-              ge=0.0),
+              gt=0.0),
     )
     TOPICS = ()
     READS = (PATH, ROBOT_POSE, GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW)
