@@ -17,6 +17,7 @@ the demo's ``summary.json``.
 from __future__ import annotations
 
 import copy
+import functools
 import io
 import itertools
 import json
@@ -152,12 +153,14 @@ def navigation_plugins() -> dict[str, list[str]]:
     return found
 
 
+@functools.cache
 def plugin_class(kind_name: str, name: str) -> type:
     kind = {k.name: k for k in ALL_KINDS}[kind_name]
     return load_plugin_class(kind, name, f"matrix.{kind_name.replace(' ', '_')}")
 
 
-def world_sensors(world: str) -> set[str]:
+@functools.cache
+def world_sensors(world: str) -> frozenset[str]:
     """The sensors a shipped world's robot has: a laser always; an IMU, a GNSS receiver and a
     3D lidar where the world declares them."""
     from easynav.playground.world_description import WorldDescription
@@ -170,7 +173,7 @@ def world_sensors(world: str) -> set[str]:
         sensors.add("gnss")
     if description.robot is not None and description.robot.lidar is not None:
         sensors.add("lidar")
-    return sensors
+    return frozenset(sensors)
 
 
 def needed_sensors(cls: type) -> set[str]:
@@ -327,33 +330,44 @@ def covering_slice(combos: list[Combination]) -> list[Combination]:
     return chosen
 
 
-#: The world a params file was written for: its "Run: easynav demo --world NAME" line.
-_RUN_WORLD = re.compile(r"--world\s+(\w+)")
+#: The world a params file was written for: its "# Run: easynav demo --world NAME" line.
+_RUN_WORLD = re.compile(r"^#.*?\bRun:.*?--world\s+(\w+)", re.MULTILINE)
 
 
 def params_world(text: str) -> str | None:
-    """The world a params file's text names in its ``--world NAME`` run line (None: none, the
-    demo's default world)."""
+    """The world a params file's text names in its ``# Run: ... --world NAME`` comment line
+    (None: none, the demo's default world)."""
     match = _RUN_WORLD.search(text)
     return match.group(1) if match else None
+
+
+@functools.lru_cache(maxsize=1)
+def _readable_params_files() -> tuple[tuple[Path, str | None, dict], ...]:
+    """``(path, world, document)`` of each readable params file, read once (composing the
+    thousand combinations reads them for each): the playground's own file, then params/ in
+    name order. The documents are shared: a caller copies what it keeps."""
+    others = [p for p in sorted(PARAMS_DIR.glob("*.yaml")) if p.resolve() != BASE_PARAMS.resolve()]
+    found = []
+    for path in [BASE_PARAMS, *others]:
+        text = path.read_text()
+        try:
+            document = load_ros_yaml(text)
+        except yaml.YAMLError:
+            continue
+        if isinstance(document, dict):
+            found.append((path, params_world(text), document))
+    return tuple(found)
 
 
 def _params_documents(world: str | None = None):
     """``(path, document)`` of each readable params file: those written for ``world`` (their
     run line names it) first, then the playground's own file (the base of every combination,
     tuned for the indoor worlds), then params/ in name order."""
-    others = [p for p in sorted(PARAMS_DIR.glob("*.yaml")) if p.resolve() != BASE_PARAMS.resolve()]
-    paths = [BASE_PARAMS, *others]
-    texts = {path: path.read_text() for path in paths}
+    files = list(_readable_params_files())
     if world is not None:
-        paths.sort(key=lambda path: params_world(texts[path]) != world)  # stable
-    for path in paths:
-        try:
-            document = load_ros_yaml(texts[path])
-        except yaml.YAMLError:
-            continue
-        if isinstance(document, dict):
-            yield path, document
+        files.sort(key=lambda entry: entry[1] != world)  # stable
+    for path, _, document in files:
+        yield path, document
 
 
 def representative_sections(world: str | None = None) -> dict[str, dict]:
@@ -435,27 +449,31 @@ SENSOR_KINDS = {
 
 
 def _add_the_sensors_they_read(document: dict, combo: Combination, sections: dict) -> None:
-    """The sensors_node sensors of each chosen plugin's representative params file, where the
-    world's robot has that kind of sensor (:data:`SENSOR_KINDS`): the fusion and GTSAM
-    localizers read their GNSS fixes through sensors_node (group ``gnss``), which the
-    playground's own file (a laser) does not declare; without them they never had a fix to
-    start from, and no pose. A sensor the base file already declares by name is kept."""
+    """For each chosen plugin that declares the sensors it needs (``NEEDS_SENSORS``), the
+    sensors_node sensors of those kinds (:data:`SENSOR_KINDS`) in its representative params
+    file, where the world's robot has them: the fusion and GTSAM localizers read their GNSS fixes
+    through sensors_node (group ``gnss``), which the playground's own file (a laser) does not
+    declare; without them they never had a fix to start from, and no pose. Another plugin taken
+    from the same file (the campus's SimplePlanner) brings none. A sensor the base file already
+    declares by name is kept."""
     sensors = document.setdefault("sensors_node", {}).setdefault("ros__parameters", {})
     names = sensors.setdefault("sensors", [])
     robot = world_sensors(combo.world)
-    for plugin in combo.plugins:
+    chosen = [("maps manager", m) for m in combo.maps_managers] + [
+        ("localizer", combo.localizer), ("planner", combo.planner),
+        ("controller", combo.controller),
+    ]
+    for kind, plugin in chosen:
         known = sections.get(plugin)
-        if not known:
+        wanted = needed_sensors(plugin_class(kind, plugin)) & robot
+        if not known or not wanted:
             continue
-        try:
-            source = load_ros_yaml((PARAMS_DIR / known["file"]).read_text())
-        except (OSError, yaml.YAMLError):
-            continue
-        theirs = ((source or {}).get("sensors_node") or {}).get("ros__parameters") or {}
+        source = next((d for p, _, d in _readable_params_files() if p.name == known["file"]), {})
+        theirs = (source.get("sensors_node") or {}).get("ros__parameters") or {}
         for name in theirs.get("sensors") or []:
             sensor = theirs.get(name)
             if (name in names or not isinstance(sensor, dict)
-                    or SENSOR_KINDS.get(sensor.get("type")) not in robot):
+                    or SENSOR_KINDS.get(sensor.get("type")) not in wanted):
                 continue
             names.append(name)
             sensors[name] = copy.deepcopy(sensor)

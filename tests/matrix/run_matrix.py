@@ -26,9 +26,11 @@ causes found, each for the rows it explains; a failure nobody looked into says s
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import platform
+import shutil
 import signal
 import subprocess
 import sys
@@ -39,6 +41,8 @@ from concurrent.futures import ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
 
+import yaml
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from matrix import (  # noqa: E402 (the folder is not a package)
@@ -46,6 +50,7 @@ from matrix import (  # noqa: E402 (the folder is not a package)
     WORLDS,
     Outcome,
     combinations,
+    compose_params,
     covering_slice,
     load_findings,
     markdown,
@@ -69,6 +74,20 @@ def load_results(path: Path) -> dict[str, dict]:
         except (ValueError, KeyError, TypeError):
             continue
     return found
+
+
+def params_fingerprint(combo) -> str:
+    """A short hash of the params document a combination runs with: a kept row whose params
+    differ (a params file retuned, the composition changed) is stale and runs again."""
+    text = yaml.safe_dump(compose_params(combo), sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def stale_rows(combos, kept: dict[str, dict], fingerprints: dict[str, str]) -> set[str]:
+    """The combinations kept with params other than they compose to now (no fingerprints: none).
+    A row kept before rows had a fingerprint is stale too."""
+    return {c.name for c in combos if fingerprints and c.name in kept
+            and kept[c.name].get("params") != fingerprints[c.name]}
 
 
 def source_commit() -> str:
@@ -170,10 +189,13 @@ def main(argv: list[str]) -> int:
     if args.fresh:
         results_path.unlink(missing_ok=True)
     kept = load_results(results_path)
-    todo = [] if args.report else [c for c in combos if c.name not in kept]
-    done_before = sum(c.name in kept for c in combos)
-    print(f"{len(combos)} combinations: {done_before} already in {results_path}, "
-          f"{len(todo)} to run, {args.jobs} at a time", flush=True)
+    fingerprints = {} if args.report else {c.name: params_fingerprint(c) for c in combos}
+    stale = stale_rows(combos, kept, fingerprints)
+    todo = [] if args.report else [c for c in combos if c.name not in kept or c.name in stale]
+    done_before = sum(c.name in kept for c in combos) - len(stale)
+    print(f"{len(combos)} combinations: {done_before} done in {results_path}, {len(stale)} "
+          f"kept there with other params (run again), {len(todo)} to run, {args.jobs} at a time",
+          flush=True)
     started = datetime.now(timezone.utc)
     commit = source_commit()
     work = Path(tempfile.mkdtemp(prefix="easynav-matrix-"))
@@ -186,6 +208,8 @@ def main(argv: list[str]) -> int:
         row = _run_in_process(combo.name, work / f"{i:03d}", args)
         row["seconds"] = round(time.monotonic() - t0, 1)
         row["commit"] = commit
+        row["params"] = fingerprints[combo.name]
+        row["speed_up"] = args.speed_up
         run_dir = row.pop("run_dir", "")  # a temporary folder: not kept in the row
         if _stopped_half_way(row):  # a mission killed on its own is no result: run it again
             print(f"[-] {combo.name}: stopped before its end ({row['error']}), not kept",
@@ -198,6 +222,8 @@ def main(argv: list[str]) -> int:
             finished[0] += 1
             green = row["exit_code"] == 0 and row["summary"].get("success")
             verdict = "green" if green else f"FAILED ({row['error']}; the run: {run_dir})"
+            if green:  # its logs and picture are kept for failures only (2.5 MB a run)
+                shutil.rmtree(work / f"{i:03d}", ignore_errors=True)
             print(f"[{finished[0]}/{len(todo)}] {combo.name}: {verdict} ({row['seconds']:.0f} s)",
                   flush=True)
 
@@ -227,8 +253,12 @@ def main(argv: list[str]) -> int:
         "Written by `make matrix` (tests/matrix/run_matrix.py): every compatible combination of "
         "the installed maps managers, localizers, planners and controllers (compatibility as the "
         "plugins declare it) in each world, each a waypoint mission of the playground. CI runs "
-        "the slice that uses every plugin at least once (`--slice`). A failed row says what a "
-        "user would notice first and, once looked into, why (tests/matrix/findings.yaml).",
+        "the slice that uses every plugin at least once (`--slice`). Each plugin is configured "
+        "as in a params file written for the row's world where there is one (`# Run: ... "
+        "--world NAME`: the tb3_sandbox's costmap files, the depot's costmap with its keepout "
+        "and speed zones, the campus's files for the Simple* plugins), else as in the "
+        "playground's file or the first file under params/ that uses it. A failed row says what "
+        "a user would notice first and, once looked into, why (tests/matrix/findings.yaml).",
         "",
         f"- date: {started:%Y-%m-%d %H:%M} UTC (rows of earlier parts come from {results_path.name}"
         f"); Python {platform.python_version()}; speed-up x{args.speed_up:g}; "

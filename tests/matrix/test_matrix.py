@@ -132,6 +132,29 @@ def test_a_localizer_gets_the_sensors_its_file_declares_where_the_robot_has_them
     assert indoors["sensors_node"]["ros__parameters"]["sensors"] == ["laser"]
 
 
+def test_only_a_plugin_that_needs_a_sensor_brings_it_from_its_file():
+    # The campus's Simple* sections come from the fusion file, whose sensors_node reads GNSS
+    # for its localizer: an AMCL stack with those sections has no use for the receiver.
+    amcl = "easynav_simple_localizer/AMCLLocalizer"
+    combo = next(c for c in combinations(("campus",))
+                 if c.localizer == amcl and c.planner == "easynav_simple_planner/SimplePlanner")
+    sensors = compose_params(combo)["sensors_node"]["ros__parameters"]
+    assert sensors["sensors"] == ["laser"]
+
+
+def test_a_row_kept_with_other_params_runs_again():
+    from run_matrix import params_fingerprint, stale_rows
+
+    home = combinations(("home",))[:3]
+    prints = {c.name: params_fingerprint(c) for c in home}
+    assert len(set(prints.values())) == 3 and params_fingerprint(home[0]) == prints[home[0].name]
+    kept = {home[0].name: {"params": prints[home[0].name]},
+            home[1].name: {"params": "retuned"},
+            home[2].name: {}}  # kept before rows had a fingerprint
+    assert stale_rows(home, kept, prints) == {home[1].name, home[2].name}
+    assert stale_rows(home, kept, {}) == set()  # --report: nothing is run
+
+
 def test_two_maps_managers_side_by_side_only_where_a_plugin_needs_both():
     from matrix import plugin_class
 
