@@ -132,6 +132,27 @@ def test_a_localizer_gets_the_sensors_its_file_declares_where_the_robot_has_them
     assert indoors["sensors_node"]["ros__parameters"]["sensors"] == ["laser"]
 
 
+def test_the_files_written_for_a_world_agree_on_the_plugins_they_share():
+    # A matrix world's files come first in name order; if two of them configured a plugin
+    # differently, retuning one would silently change every row of that world.
+    from matrix import _readable_params_files
+
+    seen: dict[tuple[str, str], tuple[str, dict]] = {}
+    for path, world, document in _readable_params_files():
+        if world not in WORLDS:
+            continue
+        for node, types_key, _ in AXES:
+            params = (document.get(node) or {}).get("ros__parameters") or {}
+            for alias in params.get(types_key) or []:
+                section = params.get(alias)
+                if not isinstance(section, dict) or "plugin" not in section:
+                    continue
+                first = seen.setdefault((world, section["plugin"]), (path.name, section))
+                assert section == first[1], (
+                    f"{world}: {path.name} and {first[0]} configure {section['plugin']} apart"
+                )
+
+
 def test_only_a_plugin_that_needs_a_sensor_brings_it_from_its_file():
     # The campus's Simple* sections come from the fusion file, whose sensors_node reads GNSS
     # for its localizer: an AMCL stack with those sections has no use for the receiver.
