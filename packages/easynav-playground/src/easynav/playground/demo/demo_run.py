@@ -27,6 +27,7 @@ from easynav.playground.demo.navmap_params import goal_height
 from easynav.playground.demo.progress_line import ProgressLine
 from easynav.playground.demo.run_plot import plot_run
 from easynav.playground.demo.run_summary import RunSummary
+from easynav.playground.demo.stop_signals import StopSignals
 from easynav.playground.demo.waypoint_result import WaypointResult
 from easynav.playground.sim.ground_truth_recorder import GroundTruthRecorder
 
@@ -102,15 +103,17 @@ class DemoRun:
         self.status_message = ""
         self.nav_start = math.nan
         self.nav_end = math.nan
+        self._stop_signals = StopSignals()
 
     # ------------------------------------------------------------------ the run
     def execute(self) -> int:
         """Run the mission and report; returns the demo's exit code."""
         self._open_ros()
         try:
-            self._start()
-            self._send_waypoints()
-            self._follow()
+            with self._stop_signals:
+                self._start()
+                self._send_waypoints()
+                self._follow()
         except DemoError as err:
             self.progress.finish()
             print(f"easynav demo: {err}", file=sys.stderr)
@@ -203,7 +206,7 @@ class DemoRun:
                 self.status_message = f"no result within {self.timeout:.0f} s"
                 client.cancel()
                 break
-            self.executor.spin_once(timeout_sec=SPIN_STEP)
+            self._spin()
         self.nav_end = monitor.truth[0]
 
     def _mark_reached(self, state, feedback) -> None:
@@ -263,7 +266,13 @@ class DemoRun:
             self._check_children(f" while {what}")
             if time.monotonic() > deadline:
                 raise DemoError(f"timed out after {seconds:.0f} s {what}")
-            self.executor.spin_once(timeout_sec=SPIN_STEP)
+            self._spin()
+
+    def _spin(self) -> None:
+        """One wait of the executor; then a Ctrl-C or SIGTERM that arrived ends the run, raised
+        here rather than inside a callback of the EventsExecutor (see StopSignals)."""
+        self.executor.spin_once(timeout_sec=SPIN_STEP)
+        self._stop_signals.check()
 
     # ------------------------------------------------------------------ the report
     def _report(self) -> int:

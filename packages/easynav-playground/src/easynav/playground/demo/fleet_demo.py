@@ -252,6 +252,7 @@ def _run(description, runs, children, domain, record, output_png, timeout, ready
 
     from easynav.core.types import Header, Pose, PoseStamped
     from easynav.playground.demo.run_monitor import RunMonitor
+    from easynav.playground.demo.stop_signals import StopSignals
     from easynav.system.executor import make_executor
     from easynav.system.goals.goal_client_state import GoalClientState as S
     from easynav.system.goals.goal_manager_client import GoalManagerClient
@@ -271,6 +272,8 @@ def _run(description, runs, children, domain, record, output_png, timeout, ready
     watch = TopicWatch()
     names = [r.name for r in runs]
     code = EXIT_FAILURE
+    # Ctrl-C / SIGTERM raised after a spin, not inside the EventsExecutor's callbacks.
+    stop = StopSignals().__enter__()
     try:
         for child in children:
             child.start()
@@ -295,6 +298,7 @@ def _run(description, runs, children, domain, record, output_png, timeout, ready
                 if time.monotonic() > deadline:
                     raise FleetDemoError(f"timed out after {seconds:.0f} s {what}")
                 executor.spin_once(timeout_sec=SPIN_STEP)
+                stop.check()
 
         progress.show("waiting for the playground and the EasyNav instances...", force=True)
         spin_until(lambda: all(r.monitor.truth is not None for r in runs), ready_timeout,
@@ -338,6 +342,7 @@ def _run(description, runs, children, domain, record, output_png, timeout, ready
                         r.client.cancel()
                 break
             executor.spin_once(timeout_sec=SPIN_STEP)
+            stop.check()
         watch.look(runs[0].monitor, names)
     except FleetDemoError as err:
         progress.finish()
@@ -355,6 +360,7 @@ def _run(description, runs, children, domain, record, output_png, timeout, ready
                 if r.client is not None and r.client.get_state().is_navigating:
                     r.client.cancel()
     finally:
+        stop.__exit__(None, None, None)
         progress.finish()
         for child in reversed(children):  # the EasyNav instances first, then the robots
             child.stop()
