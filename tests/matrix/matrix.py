@@ -370,6 +370,16 @@ def _params_documents(world: str | None = None):
         yield path, document
 
 
+def plugin_sections(document: dict):
+    """``(alias, section)`` of every navigation plugin a params document configures."""
+    for node, types_key, _ in AXES:
+        params = (document.get(node) or {}).get("ros__parameters") or {}
+        for alias in params.get(types_key) or []:
+            section = params.get(alias)
+            if isinstance(section, dict) and "plugin" in section:
+                yield alias, section
+
+
 def representative_sections(world: str | None = None) -> dict[str, dict]:
     """For each plugin name, its configuration (alias section) in the first params file that
     uses it: a file written for ``world`` first, then the playground's own file (the base of
@@ -379,16 +389,11 @@ def representative_sections(world: str | None = None) -> dict[str, dict]:
     the campus, 0.2 m, let a robot placed by GNSS alone clip a building's corner.)"""
     sections: dict[str, dict] = {}
     for path, document in _params_documents(world):
-        for node, types_key, _ in AXES:
-            params = (document.get(node) or {}).get("ros__parameters") or {}
-            for alias in params.get(types_key) or []:
-                section = params.get(alias)
-                if not isinstance(section, dict) or "plugin" not in section:
-                    continue
-                sections.setdefault(
-                    section["plugin"],
-                    {"file": path.name, "alias": alias, "section": copy.deepcopy(section)},
-                )
+        for alias, section in plugin_sections(document):
+            sections.setdefault(
+                section["plugin"],
+                {"file": path.name, "alias": alias, "section": copy.deepcopy(section)},
+            )
     return sections
 
 

@@ -22,6 +22,7 @@ from matrix import (
     markdown,
     navigation_plugins,
     params_world,
+    plugin_sections,
     representative_sections,
     run_combination,
     unmatched_plugins,
@@ -141,16 +142,11 @@ def test_the_files_written_for_a_world_agree_on_the_plugins_they_share():
     for path, world, document in _readable_params_files():
         if world not in WORLDS:
             continue
-        for node, types_key, _ in AXES:
-            params = (document.get(node) or {}).get("ros__parameters") or {}
-            for alias in params.get(types_key) or []:
-                section = params.get(alias)
-                if not isinstance(section, dict) or "plugin" not in section:
-                    continue
-                first = seen.setdefault((world, section["plugin"]), (path.name, section))
-                assert section == first[1], (
-                    f"{world}: {path.name} and {first[0]} configure {section['plugin']} apart"
-                )
+        for _, section in plugin_sections(document):
+            first = seen.setdefault((world, section["plugin"]), (path.name, section))
+            assert section == first[1], (
+                f"{world}: {path.name} and {first[0]} configure {section['plugin']} apart"
+            )
 
 
 def test_only_a_plugin_that_needs_a_sensor_brings_it_from_its_file():
