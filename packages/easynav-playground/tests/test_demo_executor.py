@@ -64,3 +64,56 @@ def test_the_monitor_and_the_goal_client_take_messages_on_it():
         sender.destroy_node()
         monitor.destroy_node()
         rclpy.shutdown(context=context)
+
+
+def test_a_localizer_outside_tf_is_scored_from_its_estimate_topic():
+    """The GpsLocalizer broadcasts an identity map -> odom: the monitor records the pose it
+    publishes, not odometry composed with that identity (which would score the odometry)."""
+    from nav_msgs.msg import Odometry
+    from tf2_msgs.msg import TFMessage
+
+    from easynav.playground.demo.run_monitor import RunMonitor
+    from easynav.system.executor import make_executor
+
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    executor = make_executor(context)
+    monitor = RunMonitor(None, estimate_topic="/robot/odom_gps", context=context)
+    sender = rclpy.create_node("demo_estimate_sender", context=context)
+    try:
+        executor.add_node(monitor)
+        executor.add_node(sender)
+        estimates = sender.create_publisher(Odometry, "/robot/odom_gps", 10)
+        tf = sender.create_publisher(TFMessage, "/tf", 10)
+        fix = Odometry()
+        fix.header.frame_id = "map"
+        fix.pose.pose.position.x, fix.pose.pose.position.y = 3.0, 4.0
+        odometry = TFMessage()
+        odometry.transforms = [
+            _transform("map", "odom", 0.0), _transform("odom", "base_footprint", 9.0)
+        ]
+        end = time.monotonic() + 10.0
+        while not monitor.estimates.estimated_poses and time.monotonic() < end:
+            tf.publish(odometry)
+            estimates.publish(fix)
+            executor.spin_once(timeout_sec=0.05)
+        for _ in range(10):  # the TF messages still queued
+            executor.spin_once(timeout_sec=0.01)
+        poses = monitor.estimates.estimated_poses
+        assert poses, "the monitor recorded no estimate from the localizer's topic"
+        assert {(x, y) for _, x, y, _ in poses} == {(3.0, 4.0)}
+    finally:
+        executor.shutdown()
+        sender.destroy_node()
+        monitor.destroy_node()
+        rclpy.shutdown(context=context)
+
+
+def _transform(parent: str, child: str, x: float):
+    from geometry_msgs.msg import TransformStamped
+
+    t = TransformStamped()
+    t.header.frame_id, t.child_frame_id = parent, child
+    t.transform.translation.x = x
+    t.transform.rotation.w = 1.0
+    return t

@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from easynav.playground.demo.demo import DEFAULT_PARAMS, build_parser, run_demo
-from easynav.playground.demo.params_patch import derive_params
+from easynav.playground.demo.params_patch import derive_params, pose_estimate_topic
 from easynav.playground.demo.progress_line import ProgressLine
 from easynav.playground.demo.run_monitor import compose
 from easynav.playground.demo.run_plot import plot_run
@@ -211,3 +211,15 @@ def test_the_controller_cycle_is_read_from_easynavs_log(tmp_path):
     summary.controller_cycle = cycle
     assert "controller cycle:     median 0.31 ms, p99 1.20 ms, max 3.40 ms (rpp: " in (
         summary.format_table())
+
+
+def test_the_gps_localizers_estimate_is_read_from_its_topic(tmp_path):
+    """Its map -> odom is a static identity (as the original's): the demo scores the pose it
+    publishes on robot/odom_gps; every other localizer is read from TF."""
+    params = tmp_path / "p.yaml"
+    gps = {"plugin": "easynav_gps_localizer/GpsLocalizer"}
+    localizer = {"localizer_types": ["gps"], "gps": gps}
+    params.write_text(yaml.safe_dump({"localizer_node": {"ros__parameters": localizer}}))
+    assert pose_estimate_topic(params) == "/robot/odom_gps"
+    assert pose_estimate_topic(DEFAULT_PARAMS) is None
+    assert pose_estimate_topic(tmp_path / "missing.yaml") is None

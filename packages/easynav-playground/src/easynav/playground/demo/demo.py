@@ -36,6 +36,7 @@ from easynav.playground.demo.params_patch import (
     derive_params,
     laser_scan_topics,
     planner_plugins,
+    pose_estimate_topic,
 )
 from easynav.playground.reachability import reachable_from
 from easynav.playground.world_description import (
@@ -118,6 +119,7 @@ def run_demo(
         run_path.mkdir(parents=True, exist_ok=True)
         derived, notes, path_topic = _derive_run_params(description, params_path, run_path)
         costmap_planning = COSTMAP_PLANNER in planner_plugins(params_path)
+        estimate_topic = pose_estimate_topic(params_path)
         scan_topics = laser_scan_topics(params_path)
         easynav = _easynav_command()
     except (OSError, ValueError, DemoError) as err:
@@ -155,7 +157,7 @@ def run_demo(
     try:
         return DemoRun(
             description, waypoint_list, waypoint_levels, children, domain, path_topic, record,
-            output_png, timeout, ready_timeout, out,
+            output_png, timeout, ready_timeout, out, estimate_topic=estimate_topic,
         ).execute()
     finally:
         if reservation is not None:

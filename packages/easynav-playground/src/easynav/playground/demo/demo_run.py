@@ -62,6 +62,8 @@ class DemoRun:
         timeout: wall seconds of navigation before the run is cancelled.
         ready_timeout: wall seconds to wait for the playground, the goal manager and its answer.
         out: where the progress and the summary are printed.
+        estimate_topic: where the localizer publishes its pose when TF does not carry it
+            (None: EasyNav's estimate is read from TF).
 
     Thread contract: main thread only; ``execute()`` once. A Ctrl-C during the run cancels the
     navigation, stops the processes and reports (exit code 130).
@@ -80,6 +82,7 @@ class DemoRun:
         timeout: float,
         ready_timeout: float,
         out: TextIO,
+        estimate_topic: str | None = None,
     ) -> None:
         self.description = description
         self.results = [WaypointResult(i, *w) for i, w in enumerate(waypoints, 1)]
@@ -93,6 +96,7 @@ class DemoRun:
         self.timeout = timeout
         self.ready_timeout = ready_timeout
         self.out = out
+        self.estimate_topic = estimate_topic
         self.progress = ProgressLine(out)
         self.context = None
         self.executor = None
@@ -154,7 +158,9 @@ class DemoRun:
 
         for child in self.children:
             child.start()
-        self.monitor = RunMonitor(self.path_topic, context=self.context)
+        self.monitor = RunMonitor(
+            self.path_topic, estimate_topic=self.estimate_topic, context=self.context
+        )
         self.executor.add_node(self.monitor)
         self.client = GoalManagerClient(self.monitor)
         self.progress.show("waiting for the playground and EasyNav...", force=True)

@@ -19,6 +19,9 @@ VOXEL_MAPS_MANAGERS = {
     "easynav_octomap_maps_manager/OctomapMapsManager": "octomap_path_file",
     "easynav_bonxai_maps_manager/BonxaiMapsManager": "bonxai_path_file",
 }
+#: Localizers whose estimate is not in TF, and the Odometry topic (map frame) it is published
+#: on: the GpsLocalizer broadcasts an identity ``map -> odom``, as the original's does.
+ESTIMATE_TOPICS = {"easynav_gps_localizer/GpsLocalizer": "/robot/odom_gps"}
 
 
 def _get(section: dict, dotted: str, default=None):
@@ -184,6 +187,21 @@ def planner_plugins(params_path: Path) -> list[str]:
         return []
     planner = _ros_parameters(params, "planner_node") or {}
     return [str(_get(planner, f"{a}.plugin", "")) for a in planner.get("planner_types", []) or []]
+
+
+def pose_estimate_topic(params_path: Path) -> str | None:
+    """Where the localizer of a params file publishes its estimate when TF does not carry it
+    (:data:`ESTIMATE_TOPICS`); None when TF does, or when the file cannot be read."""
+    try:
+        params = yaml.safe_load(Path(params_path).read_text())
+    except (OSError, yaml.YAMLError):
+        return None
+    localizer = (_ros_parameters(params, "localizer_node") if isinstance(params, dict) else None)
+    for alias in (localizer or {}).get("localizer_types", []) or []:
+        topic = ESTIMATE_TOPICS.get(str(_get(localizer, f"{alias}.plugin", "")))
+        if topic:
+            return topic
+    return None
 
 
 def derive_fleet_params(

@@ -44,6 +44,9 @@ class RunMonitor(Node):
     - ``/tf``: ``map -> odom`` (from EasyNav's localizer) composed with ``odom ->
       base_footprint`` (from the playground) gives EasyNav's pose estimate at each odometry
       stamp, recorded in :attr:`estimates` for the localisation error;
+    - ``estimate_topic`` instead, when given: the localizer's pose (an Odometry in the map
+      frame) for a localizer whose estimate is not in TF (the GpsLocalizer's map -> odom is a
+      static identity: composing it with odometry would score the odometry, not the estimate);
     - with a ``frame_prefix`` (one robot of several, the node in the robot's namespace): its
       own ``tf`` (``/r1/tf``) instead, the frames prefixed (``r1/map``...), and every frame
       seen there without the prefix is kept in :attr:`foreign_frames` (a crossed tree);
@@ -62,6 +65,7 @@ class RunMonitor(Node):
         path_topic: str | None,
         frames: dict[str, str] | None = None,
         frame_prefix: str = "",
+        estimate_topic: str | None = None,
         **kwargs,
     ) -> None:
         super().__init__(
@@ -105,6 +109,9 @@ class RunMonitor(Node):
         )
         if path_topic:
             self.create_subscription(PathMsg, path_topic, self._on_path, 10)
+        self._estimates_from_tf = estimate_topic is None
+        if estimate_topic:
+            self.create_subscription(Odometry, estimate_topic, self._on_estimate, reliable)
         self.create_subscription(Heartbeat, "easynav_heartbeat", self._on_heartbeat, 10)
 
     # ------------------------------------------------------------------ callbacks
@@ -118,6 +125,13 @@ class RunMonitor(Node):
                 _yaw(p.orientation),
             )
             self.speed = msg.twist.twist.linear.x
+
+    def _on_estimate(self, msg: Odometry) -> None:
+        p = msg.pose.pose
+        with self.lock:
+            self.estimates.record_estimate(
+                time_from_msg(msg.header.stamp), p.position.x, p.position.y, _yaw(p.orientation)
+            )
 
     def _on_heartbeat(self, msg: Heartbeat) -> None:
         with self.lock:
@@ -140,7 +154,7 @@ class RunMonitor(Node):
             if (parent, child) == (f["map"], f["odom"]):
                 with self.lock:
                     self.map_to_odom = pose
-            elif (parent, child) == (f["odom"], f["base"]):
+            elif (parent, child) == (f["odom"], f["base"]) and self._estimates_from_tf:
                 with self.lock:
                     if self.map_to_odom is not None:
                         x, y, yaw = compose(self.map_to_odom, pose)
