@@ -1,6 +1,10 @@
 """Every controller on the costmap stack (params/costmap.<controller>.params.yaml) driving the
-playground robot through the tours of two real maps: tb3_sandbox (0.8 m passages between
-pillars, ~1 min) and the depot (30 × 15 m, ~3 min). Slow."""
+playground robot through the tour of a real map, tb3_sandbox: 0.8 m passages between pillars,
+about a minute. Slow.
+
+The longer tours (the depot, 30 × 15 m, some 4 minutes each; the campus) are rows of the
+integration matrix (``make matrix``: every controller on every world), not of CI's suite: five
+more depot tours here took a fifth of its time budget."""
 
 from __future__ import annotations
 
@@ -16,11 +20,10 @@ PARAMS = Path(__file__).resolve().parents[3] / "params"
 CONTROLLERS = ["rpp", "mppi", "mpc", "serest", "vff"]
 
 
-@pytest.mark.parametrize("world", ["tb3_sandbox", "depot"])
 @pytest.mark.parametrize("controller", CONTROLLERS)
-def test_costmap_stack_tour_without_collision(controller, world, tmp_path):
+def test_costmap_stack_tour_without_collision(controller, tmp_path):
     mission = mission_run.MissionRun.run(
-        tmp_path, world, PARAMS / f"costmap.{controller}.params.yaml", timeout=600.0)
+        tmp_path, "tb3_sandbox", PARAMS / f"costmap.{controller}.params.yaml", timeout=600.0)
     report = mission.report
     assert mission.code == 0, report
     summary = mission.summary()
