@@ -51,14 +51,23 @@ if [ "$(cat "$STAMPS/tools" 2>/dev/null)" != "$step" ]; then
   echo "$step" > "$STAMPS/tools"
 fi
 
-# 2. The ROS message packages (CMake build of .msg files; ~10 s).
+# 2. The ROS message packages (CMake build of .msg files; about a minute). The wheel is kept in
+#    $WHEELS: the packaging tests install it into their fresh environments instead of building
+#    it again.
+WHEELS=$VENV/.easynav-wheels
 step=$(cd packages/easynav-interfaces && find . -path ./build -prune -o -type f \
   \( -name '*.msg' -o -name 'CMakeLists.txt' -o -name 'package.xml' -o -name 'setup.py' \
   -o -name 'pyproject.toml' -o -name '*.cmake' \) -print | sort | xargs cat | sha256sum | cut -c1-16)
 if [ "$(cat "$STAMPS/interfaces" 2>/dev/null)" != "$step" ] ||
    ! "$VENV/bin/python" -c 'import easynav_interfaces.msg, tf2_msgs.msg, vision_msgs.msg' 2>/dev/null; then
   log "building the ROS message packages (easynav_interfaces, tf2_msgs, vision_msgs)"
-  pip_install --no-build-isolation ./packages/easynav-interfaces
+  rm -rf "$WHEELS"
+  "$VENV/bin/python" -m pip wheel --quiet --disable-pip-version-check --no-deps \
+    --no-build-isolation ./packages/easynav-interfaces -w "$WHEELS"
+  wheel=$(ls "$WHEELS"/easynav_interfaces-*.whl)
+  # Reinstalled even at the same version (the messages changed); then its dependencies.
+  pip_install --force-reinstall --no-deps "$wheel"
+  pip_install "$wheel"
   echo "$step" > "$STAMPS/interfaces"
 fi
 
