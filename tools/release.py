@@ -31,6 +31,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -276,6 +277,8 @@ def isolated(
         if name not in packages:
             raise ReleaseError(f"no package {name!r}")
     work = Path(tempfile.mkdtemp(prefix="easynav-isolated-"))
+    started = time.monotonic()
+    spent: dict[str, float] = {}  # seconds per wheel built (and the build environment)
     try:
         wheels = work / "wheels"
         for pkg, req in closure(packages, names):
@@ -283,9 +286,14 @@ def isolated(
             # The message package has compiled parts: built by the target Python, in a build
             # environment of its own unless that Python is this one.
             builder = sys.executable
+            step = time.monotonic()
             if (folder / "setup.py").exists() and not same_python(python, sys.executable):
                 builder = build_environment(python, work, folder)
+                spent["build environment"] = time.monotonic() - step
+                step = time.monotonic()
             build_folder(folder, wheels, builder)
+            spent[pkg.name] = time.monotonic() - step
+        built = time.monotonic()
         venv = work / "venv"
         run([python, "-m", "venv", str(venv)])
         vpy = str(venv / "bin" / "python")
@@ -304,8 +312,13 @@ def isolated(
         listed = run([vpy, "-m", "pip", "list", "--format=freeze"]).stdout
         ours = sorted(line for line in listed.splitlines() if line.lower().startswith("easynav"))
         version = run([vpy, "--version"]).stdout.strip()
+        installed = time.monotonic()
         print(f"[isolated] {', '.join(names)} on {version} ({siblings} siblings): "
               + ", ".join(ours), flush=True)
+        slowest = ", ".join(f"{name} {seconds:.0f} s" for name, seconds in
+                            sorted(spent.items(), key=lambda item: -item[1])[:3])
+        print(f"[isolated] wheels built in {built - started:.0f} s ({slowest}), installed in "
+              f"{installed - built:.0f} s", flush=True)
         env = clean_environment()
         # From a copy of the tests outside the repository: nothing but the installed wheels is
         # importable (the repository's conftest gives each test process its ROS domain).
@@ -317,9 +330,11 @@ def isolated(
             "timeout = 300\nmarkers =\n  slow: long\n  ros: ROS\n  rt: real time\n"
             "filterwarnings =\n  ignore:module 'sre_:DeprecationWarning\n"
         )
-        return subprocess.run(
+        code = subprocess.run(
             [vpy, "-m", "pytest", "-q", *pytest_args, "tests"], cwd=work, env=env
         ).returncode
+        print(f"[isolated] tests ran in {time.monotonic() - installed:.0f} s", flush=True)
+        return code
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
