@@ -113,6 +113,13 @@ def registered_plugins() -> dict[str, str]:
     return found
 
 
+#: The two tests of a file run in one test process (``--dist loadgroup``): they share its
+#: ``easynav check`` (a few seconds each, importing every plugin), not run it once each.
+ONE_CHECK_PER_FILE = [
+    pytest.param(p, id=p.name, marks=pytest.mark.xdist_group(f"corpus-{p.name}")) for p in FILES
+]
+
+
 def test_the_corpus_has_files_and_a_readme():
     assert len(FILES) >= 12, FILES
     readme = (CORPUS / "README.md").read_text()
@@ -120,14 +127,14 @@ def test_the_corpus_has_files_and_a_readme():
     assert not missing, f"README.md does not describe: {missing}"
 
 
-@pytest.mark.parametrize("path", FILES, ids=lambda p: p.name)
+@pytest.mark.parametrize("path", ONE_CHECK_PER_FILE)
 def test_corpus_file_passes_the_check(path):
     result = easynav_check(path)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "configuration OK" in result.stdout, result.stdout + result.stderr
 
 
-@pytest.mark.parametrize("path", FILES, ids=lambda p: p.name)
+@pytest.mark.parametrize("path", ONE_CHECK_PER_FILE)
 def test_corpus_file_has_only_the_known_unknown_keys(path):
     found = unknown_keys(easynav_check(path))
     expected = KNOWN_UNKNOWN_KEYS.get(path.name, set())
