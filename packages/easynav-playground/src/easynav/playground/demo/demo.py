@@ -86,6 +86,7 @@ def run_demo(
     run_dir: str | Path | None = None,
     ready_timeout: float = 60.0,
     stream: TextIO | None = None,
+    stop_at_collision: bool = False,
 ) -> int:
     """Run the demo; returns the exit code (see the module documentation).
 
@@ -103,6 +104,9 @@ def run_demo(
         run_dir: where logs, the derived params and the ground truth go (default: a new
             temporary directory, kept and printed).
         ready_timeout: wall seconds to wait for the playground and the goal manager.
+        stop_at_collision: end the mission at the playground's first collision (the
+            navigation is cancelled; a scenario that shows a contact need not wait for the
+            timeout).
         stream: where progress and the summary are printed (default stdout).
 
     Thread contract: call from the main thread (it installs nothing global but runs an
@@ -158,6 +162,7 @@ def run_demo(
         return DemoRun(
             description, waypoint_list, waypoint_levels, children, domain, path_topic, record,
             output_png, timeout, ready_timeout, out, estimate_topic=estimate_topic,
+            stop_at_collision=stop_at_collision,
         ).execute()
     finally:
         if reservation is not None:

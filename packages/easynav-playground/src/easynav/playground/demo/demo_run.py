@@ -64,6 +64,7 @@ class DemoRun:
         out: where the progress and the summary are printed.
         estimate_topic: where the localizer publishes its pose when TF does not carry it
             (None: EasyNav's estimate is read from TF).
+        stop_at_collision: end the mission (cancel the navigation) at the first collision.
 
     Thread contract: main thread only; ``execute()`` once. A Ctrl-C during the run cancels the
     navigation, stops the processes and reports (exit code 130).
@@ -83,6 +84,7 @@ class DemoRun:
         ready_timeout: float,
         out: TextIO,
         estimate_topic: str | None = None,
+        stop_at_collision: bool = False,
     ) -> None:
         self.description = description
         self.results = [WaypointResult(i, *w) for i, w in enumerate(waypoints, 1)]
@@ -97,6 +99,7 @@ class DemoRun:
         self.ready_timeout = ready_timeout
         self.out = out
         self.estimate_topic = estimate_topic
+        self.stop_at_collision = stop_at_collision
         self.progress = ProgressLine(out)
         self.context = None
         self.executor = None
@@ -210,6 +213,11 @@ class DemoRun:
             if time.monotonic() > deadline:
                 self.final_state = "TIMEOUT"
                 self.status_message = f"no result within {self.timeout:.0f} s"
+                client.cancel()
+                break
+            if self.stop_at_collision and monitor.collision_count:
+                self.final_state = "COLLISION"
+                self.status_message = "stopped at the first collision"
                 client.cancel()
                 break
             self._spin()
