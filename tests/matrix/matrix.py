@@ -506,10 +506,32 @@ def _read_the_robots_sensors(document: dict) -> None:
             section["perception_group"] = ""
 
 
+#: A mission's wall-clock budget: 6 s per metre of its tour (the start, then each waypoint, in
+#: straight lines), 600 s (the demo's default) at least. The slowest green tours so far took
+#: 2.8 (campus) to 14.6 (SeReST between tb3_sandbox's pillars) simulated s per metre, the short
+#: tours well inside 600 s; the campus's 180 m, at the 0.8 real-time factor of two missions
+#: on two cores, passed 600 s with four of five waypoints reached.
+TIMEOUT_PER_METRE = 6.0
+MIN_TIMEOUT = 600.0
+
+
+@functools.cache
+def mission_timeout(world: str) -> float:
+    """Wall seconds before a mission in ``world`` is cancelled (see TIMEOUT_PER_METRE)."""
+    from easynav.playground.world_description import WorldDescription, load_waypoints
+
+    description = WorldDescription.resolve(world)
+    waypoints = load_waypoints(description.waypoints_path)
+    points = [description.start_pose[:2]] + [w[:2] for w in waypoints]
+    tour = sum(math.dist(a, b) for a, b in zip(points, points[1:], strict=False))
+    return max(MIN_TIMEOUT, TIMEOUT_PER_METRE * tour)
+
+
 def run_combination(
-    combo: Combination, run_dir: Path, speed_up: float = 1.0, timeout: float = 600.0
+    combo: Combination, run_dir: Path, speed_up: float = 1.0, timeout: float | None = None
 ) -> Outcome:
-    """Run one combination's waypoint mission in the playground."""
+    """Run one combination's waypoint mission in the playground (``timeout``: wall seconds,
+    by default :func:`mission_timeout` of its world)."""
     from easynav.playground.demo import run_demo
 
     run_dir.mkdir(parents=True, exist_ok=True)
@@ -522,7 +544,7 @@ def run_combination(
             params_file=params,
             speed_up=speed_up,
             output_png=run_dir / "run.png",
-            timeout=timeout,
+            timeout=mission_timeout(combo.world) if timeout is None else timeout,
             run_dir=run_dir / "run",
             stream=out,
         )

@@ -11,6 +11,7 @@ import dataclasses
 import pytest
 from matrix import (
     AXES,
+    MIN_TIMEOUT,
     WORLDS,
     Combination,
     Finding,
@@ -20,6 +21,7 @@ from matrix import (
     covering_slice,
     load_findings,
     markdown,
+    mission_timeout,
     navigation_plugins,
     params_world,
     plugin_sections,
@@ -157,6 +159,13 @@ def test_only_a_plugin_that_needs_a_sensor_brings_it_from_its_file():
                  if c.localizer == amcl and c.planner == "easynav_simple_planner/SimplePlanner")
     sensors = compose_params(combo)["sensors_node"]["ros__parameters"]
     assert sensors["sensors"] == ["laser"]
+
+
+def test_a_long_tour_has_the_time_it_needs_and_a_short_one_the_demos():
+    # The campus's 180 m took up to 498 s simulated (MPPI): at a real-time factor of 0.8, more
+    # than the demo's 600 s.
+    assert mission_timeout("campus") > 498 / 0.8 * 1.5
+    assert mission_timeout("home") == mission_timeout("tb3_sandbox") == MIN_TIMEOUT
 
 
 def test_a_row_kept_with_other_params_runs_again():
