@@ -10,9 +10,15 @@ import pytest
 class RosBed:
     """One ROS context and a SingleThreadedExecutor spinning in a thread, DDS kept in-process.
 
-    Shut down in the order that does not abort the interpreter: executor.shutdown(), join the
-    spinning thread, destroy nodes, then shut the context down.
+    Shut down in the order that does not abort the interpreter and does not race the spinning
+    thread: stop it and join it (it leaves its executor wait within ``SPIN_STEP``), then
+    executor.shutdown(), destroy nodes, then shut the context down. (``executor.shutdown()``
+    while the thread was still in ``spin()`` destroyed the executor's guard condition under a
+    callback that was about to trigger it: an InvalidHandle in the thread, seen once in 2035
+    tests.)
     """
+
+    SPIN_STEP = 0.05  # s per executor wait
 
     def __init__(self) -> None:
         import rclpy
@@ -22,6 +28,7 @@ class RosBed:
         rclpy.init(context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.nodes = []
+        self._stop = threading.Event()
         self._thread = threading.Thread(target=self._spin, daemon=True)
         self._started = False
 
@@ -37,16 +44,18 @@ class RosBed:
         from rclpy.executors import ExternalShutdownException
 
         try:
-            self.executor.spin()
+            while not self._stop.is_set():
+                self.executor.spin_once(timeout_sec=self.SPIN_STEP)
         except ExternalShutdownException:
             pass
 
     def close(self) -> None:
         import rclpy
 
-        self.executor.shutdown()
+        self._stop.set()
         if self._started:
             self._thread.join(5.0)
+        self.executor.shutdown()
         for node in self.nodes:
             node.destroy_node()
         rclpy.shutdown(context=self.context)
