@@ -9,7 +9,8 @@ The demo's run in five steps, one method each, so that a reader sees the order a
 3. :meth:`DemoRun._follow`: show the progress until the navigation ends, a process dies or the
    wall-clock timeout (then the navigation is cancelled);
 4. :meth:`DemoRun._stop`: stop EasyNav first (it stops the robot), then the playground;
-5. :meth:`DemoRun._report`: the summary table, ``summary.json``, ``run.json`` and the picture.
+5. :meth:`DemoRun._report`: the summary table, ``summary.json``, ``run.json``, ``paths.json``
+   and the picture.
 """
 
 from __future__ import annotations
@@ -56,8 +57,8 @@ class DemoRun:
         children: the playground's and EasyNav's processes, not started yet.
         domain: the ROS domain of the run (the children's too).
         path_topic: where EasyNav publishes its path (drawn in the picture).
-        record: the playground's ground-truth file (``run.json``, ``summary.json`` and
-            ``easynav.log`` lie beside it).
+        record: the playground's ground-truth file (``run.json``, ``summary.json``,
+            ``paths.json`` and ``easynav.log`` lie beside it).
         output_png: the picture of the run (None: none).
         timeout: wall seconds of navigation before the run is cancelled.
         ready_timeout: wall seconds to wait for the playground, the goal manager and its answer.
@@ -312,6 +313,8 @@ class DemoRun:
             summary.late_rt_cycles = monitor.late_cycles
         summary.controller_cycle = controller_cycle_from_log(self.record.with_name("easynav.log"))
         truth.save(self.record.with_name("run.json"))  # truth + EasyNav's estimates
+        if monitor is not None:
+            self.record.with_name("paths.json").write_text(json.dumps(monitor.paths_record()))
         self.record.with_name("summary.json").write_text(
             json.dumps(summary.to_dict(), indent=2)
         )

@@ -53,7 +53,8 @@ class RunMonitor(Node):
     - ``cmd_vel`` / ``cmd_vel_stamped``: the velocity commands (their simulated arrival times);
     - ``collisions`` (latched JSON from the playground);
     - ``easynav_manager_info``: the goals still to visit and the distance to the current one;
-    - ``path_topic``: the planner's debug path (each new plan is kept);
+    - ``path_topic``: the planner's debug path (each new plan is kept, with the simulated time
+      it arrived: :meth:`paths_record`);
     - ``easynav_heartbeat`` (when EasyNav publishes it): the late RT cycles since activation.
 
     Thread contract: callbacks run in the executor that spins this node (the demo's main
@@ -89,6 +90,7 @@ class RunMonitor(Node):
         self.remaining_goals: int | None = None
         self.distance_to_goal: float | None = None
         self.paths: list[np.ndarray] = []
+        self.path_times: list[float] = []  # simulated time each of ``paths`` arrived
         self.late_cycles: int | None = None
         reliable = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
         latched = QoSProfile(
@@ -193,8 +195,18 @@ class RunMonitor(Node):
             ):
                 return
             self.paths.append(points)
+            self.path_times.append(self.get_clock().now().nanoseconds * 1e-9)
 
     # ------------------------------------------------------------------ results
+    def paths_record(self) -> list[dict]:
+        """Each new plan as ``{"t": simulated seconds, "xy": [[x, y], ...]}`` (mm), in order:
+        the run directory's ``paths.json``, to see which route the robot was given when."""
+        with self.lock:
+            return [
+                {"t": round(t, 3), "xy": np.round(points, 3).tolist()}
+                for t, points in zip(self.path_times, self.paths, strict=True)
+            ]
+
     def command_rate(self, start: float, end: float) -> float:
         """Velocity commands per simulated second between two stamps (0 when none)."""
         with self.lock:
