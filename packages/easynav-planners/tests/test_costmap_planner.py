@@ -20,7 +20,14 @@ from easynav.core.types import (
     Pose,
     PoseStamped,
 )
-from easynav.planners.costmap_planner import CostmapPlanner, smooth_path
+from easynav.maps.inflation import inflate
+from easynav.planners.costmap_astar import BLOCKED_COST
+from easynav.planners.costmap_planner import (
+    CostmapPlanner,
+    leaves_ahead,
+    smooth_path,
+    without_cells_behind,
+)
 
 _namespaces = itertools.count()
 
@@ -55,7 +62,7 @@ def make_planner(params=None) -> CostmapPlanner:
     return planner
 
 
-def state_with(goal, robot_xy=(1.0, 1.0), frame="map", costmap=None) -> NavState:
+def state_with(goal, robot_xy=(1.0, 1.0), frame="map", costmap=None, robot_yaw=0.0) -> NavState:
     nav_state = NavState()
     costmap = costmap or room()
     nav_state.set("map", costmap)
@@ -63,7 +70,7 @@ def state_with(goal, robot_xy=(1.0, 1.0), frame="map", costmap=None) -> NavState
     nav_state.set("map_time", 4.5)
     nav_state.set(
         "robot_pose",
-        Odometry(Header(3.0, "map"), "base_footprint", Pose.from_xy_yaw(*robot_xy, 0.0)),
+        Odometry(Header(3.0, "map"), "base_footprint", Pose.from_xy_yaw(*robot_xy, robot_yaw)),
     )
     g = PoseStamped(Header(5.0, frame), Pose.from_xy_yaw(*goal))
     nav_state.set("goals", Goals(Header(5.0, frame), [g]))
@@ -263,3 +270,76 @@ def test_the_previous_route_gives_way_when_blocked_or_much_dearer():
     nav_state = state_with((1.775, 1.775, 0.0), robot_xy=robot, costmap=blocked)
     planner.update(nav_state)
     assert side_of_pillar(nav_state.get("path", Path)) == first
+
+
+def pillar_grid() -> Costmap2D:
+    """4.4 m square at 0.05 m, pillars of 0.15 m radius 1.1 m apart (the TurtleBot3 sandbox's
+    layout), inflated as the costmap stack does (0.7 m, k = 3, inscribed 0.15 m). From the
+    middle of one square of pillars to the middle of the next one diagonally, the routes up
+    then right and right then up cost the same."""
+    yy, xx = (np.indices((88, 88)) + 0.5) * 0.05
+    data = np.zeros((88, 88), dtype=np.uint8)
+    for px, py in itertools.product((1.1, 2.2, 3.3), repeat=2):
+        data[np.hypot(xx - px, yy - py) <= 0.15] = 254
+    return Costmap2D(inflate(data, 0.05, 0.7, 0.15, 3.0), 0.05, 0.0, 0.0, "map", 4.5)
+
+
+def first_move(path: Path, start=(1.65, 1.65)) -> str:
+    """"up" or "right": where the path is when it is 0.4 m from the start."""
+    points = xy(path)
+    far = points[np.hypot(points[:, 0] - start[0], points[:, 1] - start[1]) >= 0.4][0]
+    return "up" if far[1] - start[1] > far[0] - start[0] else "right"
+
+
+@pytest.mark.parametrize(("robot_yaw", "move"), [(np.pi / 2, "up"), (0.0, "right")])
+def test_of_two_equal_routes_the_robot_takes_the_one_it_faces(robot_yaw, move):
+    # At a waypoint the robot faces its yaw; the next goal lies beyond a pillar with a route on
+    # either side. The one ahead is taken: turning towards the other, the robot would drift
+    # between the two and have the path flip back under it beside the pillar.
+    planner = make_planner()
+    nav_state = state_with((2.75, 2.75, 0.0), robot_xy=(1.65, 1.65), costmap=pillar_grid(),
+                           robot_yaw=robot_yaw)
+    planner.update(nav_state)
+    assert first_move(nav_state.get("path", Path)) == move
+
+
+def test_the_route_ahead_is_kept_while_the_robot_turns():
+    planner = make_planner()
+    for robot_yaw in (np.pi / 2, 0.8, 0.3):  # a controller hesitating between the two
+        nav_state = state_with((2.75, 2.75, 0.0), robot_xy=(1.65, 1.65), costmap=pillar_grid(),
+                               robot_yaw=robot_yaw)
+        planner.update(nav_state)
+        assert first_move(nav_state.get("path", Path)) == "up"
+
+
+def test_a_robot_facing_away_from_a_much_cheaper_path_turns_round():
+    # The goal is behind the robot: going ahead first would cost far more than 10 % extra, so
+    # the path leaves behind the robot.
+    planner = make_planner()
+    nav_state = state_with((1.0, 3.0, 0.0), robot_xy=(3.0, 3.0), robot_yaw=0.0)
+    planner.update(nav_state)
+    points = xy(nav_state.get("path", Path))
+    assert (points[:, 0] <= 3.0 + 1e-9).all()
+
+
+def test_without_hysteresis_the_heading_is_ignored_as_in_the_original():
+    moves = set()
+    for robot_yaw in (np.pi / 2, 0.0):
+        planner = make_planner({"replan_hysteresis": 0.0})
+        nav_state = state_with((2.75, 2.75, 0.0), robot_xy=(1.65, 1.65), costmap=pillar_grid(),
+                               robot_yaw=robot_yaw)
+        planner.update(nav_state)
+        moves.add(first_move(nav_state.get("path", Path)))
+    assert len(moves) == 1
+
+
+def test_leaves_ahead_and_the_blocked_cells_agree():
+    costs = np.zeros((20, 20), dtype=np.uint8)
+    masked = without_cells_behind(costs, (10, 10), np.pi / 2, 6)
+    assert masked[10, 10] == 0  # the robot's cell
+    assert masked[16, 10] == 0 and masked[14, 13] == 0  # ahead (up), 37 degrees off
+    assert masked[10, 16] == BLOCKED_COST and masked[4, 10] == BLOCKED_COST  # right, behind
+    assert masked[10, 17] == 0  # beyond the radius
+    up = np.array([[10, 10], [10, 11], [11, 12], [12, 13], [13, 14], [14, 15], [15, 16]])
+    right = np.array([[10, 10], [11, 10], [12, 11], [13, 11]])
+    assert leaves_ahead(up, np.pi / 2, 6) and not leaves_ahead(right, np.pi / 2, 6)

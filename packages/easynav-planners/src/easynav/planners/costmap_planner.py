@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from easynav.core.nav_state import NavState
@@ -17,12 +19,19 @@ from easynav.planners.costmap_astar import (
 )
 from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, PathPlannerBase
 
-__all__ = ["DIAGNOSTIC_NAME", "HARDWARE_ID", "CostmapPlanner", "smooth_path"]
+__all__ = [
+    "DIAGNOSTIC_NAME", "HARDWARE_ID", "CostmapPlanner", "behind", "leaves_ahead",
+    "smooth_path", "without_cells_behind",
+]
 #: Width of the moving average that smooths the cell path (the original's 5 points).
 SMOOTHING_WINDOW = 5
 #: Farthest the robot may be from the previous route for that route to be kept (m): farther,
 #: the robot has left it and the new cheapest path is taken.
 MAX_ROUTE_GAP = 0.5
+#: A path "leaves ahead" of the robot when its cells within this distance of the robot (m) all
+#: lie within :data:`AHEAD_HALF_ANGLE` of the robot's heading.
+AHEAD_RADIUS = 0.3
+AHEAD_HALF_ANGLE = math.radians(60.0)
 
 
 def smooth_path(points: np.ndarray, window: int = SMOOTHING_WINDOW) -> np.ndarray:
@@ -37,6 +46,36 @@ def smooth_path(points: np.ndarray, window: int = SMOOTHING_WINDOW) -> np.ndarra
     i = np.arange(n)
     reach = np.minimum(np.minimum(i, n - 1 - i), half)  # symmetric window, 0 at the ends
     return (cumulative[i + reach + 1] - cumulative[i - reach]) / (2 * reach + 1)[:, None]
+
+
+def behind(dx: np.ndarray, dy: np.ndarray, yaw: float, radius_cells: int) -> np.ndarray:
+    """Which cell offsets ``(dx, dy)`` from the robot's cell lie within ``radius_cells`` of it
+    (the cell itself excluded) more than :data:`AHEAD_HALF_ANGLE` off the heading ``yaw``."""
+    distance = np.hypot(dx, dy)
+    cosine = (dx * math.cos(yaw) + dy * math.sin(yaw)) / np.maximum(distance, 1e-12)
+    return (distance > 0) & (distance <= radius_cells) & (
+        cosine < math.cos(AHEAD_HALF_ANGLE) - 1e-9)
+
+
+def leaves_ahead(cells: np.ndarray, yaw: float, radius_cells: int) -> bool:
+    """Whether a cell path (``(N, 2)``, from the robot's cell) stays out of the cells
+    :func:`behind` the robot: it leaves ahead."""
+    offsets = (np.asarray(cells) - np.asarray(cells)[0]).astype(float)
+    return not behind(offsets[:, 0], offsets[:, 1], yaw, radius_cells).any()
+
+
+def without_cells_behind(costs: np.ndarray, start, yaw: float, radius_cells: int) -> np.ndarray:
+    """A copy of ``costs`` where the cells :func:`behind` the robot at cell ``start`` are
+    blocked: a search in it leaves ahead."""
+    out = np.array(costs, copy=True)
+    sx, sy = int(start[0]), int(start[1])
+    x0, x1 = max(0, sx - radius_cells), min(out.shape[1], sx + radius_cells + 1)
+    y0, y1 = max(0, sy - radius_cells), min(out.shape[0], sy + radius_cells + 1)
+    dy, dx = np.mgrid[y0 - sy:y1 - sy, x0 - sx:x1 - sx].astype(float)
+    blocked = behind(dx, dy, yaw, radius_cells)
+    window = out[y0:y1, x0:x1]
+    window[blocked] = np.maximum(window[blocked], BLOCKED_COST)
+    return out
 
 
 class CostmapPlanner(PathPlannerBase):
@@ -70,8 +109,14 @@ class CostmapPlanner(PathPlannerBase):
     while it is open and costs at most ``1 + replan_hysteresis`` times the new cheapest path.
     Where two routes cost the same (a pillar between two equal detours), the original's
     cheapest-every-cycle path flips between them as the robot moves by a cell; a controller
-    following it steers between the two, towards the obstacle that separates them. 0 gives
-    the original's behaviour.
+    following it steers between the two, towards the obstacle that separates them. When there
+    is no route to keep (a new goal; the previous route blocked or dearer) and the cheapest path
+    does not leave ahead of the robot (a cell of it within 0.3 m of the robot more than 60
+    degrees off its heading), the cheapest path that does is taken instead while it costs at most
+    ``1 + replan_hysteresis`` times as much: a robot at a waypoint facing one of two equal
+    detours takes that one, rather than turning towards the other, drifting between the two as
+    it turns, and having the path flip back under it beside the obstacle (seen on the
+    TurtleBot3 sandbox's pillars). 0 gives the original's behaviour.
 
     ROS (when hosted by a node): publishes ``<fqn>/<alias>/path`` (nav_msgs/Path) while
     subscribed.
@@ -99,8 +144,9 @@ class CostmapPlanner(PathPlannerBase):
         Param(
             "replan_hysteresis",
             0.1,
-            "keep the previous route while it costs at most (1 + this) times the new cheapest "
-            "one (0: always the cheapest, as the original)",
+            "keep the previous route, else take the cheapest path leaving ahead of the robot, "
+            "while it costs at most (1 + this) times the new cheapest one (0: always the "
+            "cheapest, as the original)",
             ge=0.0,
         ),
     )
@@ -174,11 +220,7 @@ class CostmapPlanner(PathPlannerBase):
                       f"{robot.pose.y:.2f}) to {goal_text}: blocked in the costmap")
             return
         grid = self._grid(costmap)
-        previous = self._previous_route(costmap, grid, (six, siy), goal)
-        if previous is not None:
-            limit = (1.0 + self.params.replan_hysteresis) * cost
-            if path_cost(costmap.data, previous, self.params.cost_factor) <= limit:
-                cells = previous
+        cells = self._route_with_hysteresis(costmap, grid, robot, goal, cells, cost)
         stamp = (
             float(nav_state.get(MAP_TIME)) if nav_state.has(MAP_TIME) else float(costmap.stamp)
         )
@@ -186,6 +228,32 @@ class CostmapPlanner(PathPlannerBase):
         self._last_goal, self._last_cells, self._last_path = goal, cells, path
         self._last_grid = grid
         self.write_path(nav_state, path, self._ok_message(goal_text, path))
+
+    def _route_with_hysteresis(self, costmap: Costmap2D, grid: tuple, robot: Odometry, goal,
+                               cheapest: np.ndarray, cost: float) -> np.ndarray:
+        """The previous route, else the cheapest path leaving ahead of the robot, else
+        ``cheapest``: each of the first two only while it costs at most ``1 +
+        replan_hysteresis`` times ``cost`` (see the class docstring)."""
+        if self.params.replan_hysteresis <= 0.0:
+            return cheapest
+        start = (int(cheapest[0][0]), int(cheapest[0][1]))
+        end = (int(cheapest[-1][0]), int(cheapest[-1][1]))
+        limit = (1.0 + self.params.replan_hysteresis) * cost
+        previous = self._previous_route(costmap, grid, start, goal)
+        if previous is not None and path_cost(
+                costmap.data, previous, self.params.cost_factor) <= limit:
+            return previous
+        yaw = float(robot.pose.yaw)
+        radius_cells = max(1, math.ceil(AHEAD_RADIUS / costmap.resolution))
+        if leaves_ahead(cheapest, yaw, radius_cells):
+            return cheapest
+        ahead, ahead_cost = astar_costmap(
+            without_cells_behind(costmap.data, start, yaw, radius_cells), start, end,
+            self.params.cost_factor, self.params.heuristic_scale,
+        )
+        if ahead is not None and ahead_cost <= limit:
+            return ahead
+        return cheapest
 
     @staticmethod
     def _poses(costmap: Costmap2D, cells: np.ndarray, goal) -> np.ndarray:
