@@ -89,7 +89,8 @@ def main(argv: list[str]) -> int:
     if check.returncode != 0:
         return check.returncode
     workers = os.environ.get("EASYNAV_TEST_WORKERS", "2")
-    cmd = [sys.executable, "-m", "pytest", "-n", workers, "--dist", "loadgroup"]
+    # The slowest tests' times in the log: what to look at first when the suite nears its budget.
+    cmd = [sys.executable, "-m", "pytest", "-n", workers, "--dist", "loadgroup", "--durations=25"]
     if fast:
         cmd += ["-m", "not slow"]
     cmd += extra
