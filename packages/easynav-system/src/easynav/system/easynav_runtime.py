@@ -42,9 +42,11 @@ class EasyNavRuntime:
       configure and activate. Returns False with ``error`` set when configure fails.
     - ``wait()``: blocks until a stop is requested (signal, recovery system, safety supervisor).
     - ``stop()``: controlled stop: deactivate (the controller brakes within the deceleration
-      limits and its last command is an exact zero), shutdown to Finalized, executors down,
-      loop threads joined, then ``rclpy.shutdown`` — in that order: ``rclpy.shutdown`` while an
-      executor still runs aborts the interpreter at exit (exit code 134).
+      limits and its last command is an exact zero), loop threads joined, executors down,
+      shutdown to Finalized (the plugins' entities destroyed), nodes destroyed, then
+      ``rclpy.shutdown`` — in that order: ``rclpy.shutdown`` while an executor still runs, or
+      entities destroyed while the EventsExecutor still serves them, abort the interpreter
+      (exit code 134).
 
     Thread contract: all public methods from the owner's (main) thread.
     """
@@ -179,16 +181,18 @@ class EasyNavRuntime:
             return RuntimeResult(code, reason)
         self._stopped = True
         node = self.system_node
+        # Deactivate while the loops still spin (the robot brakes on the node clock, which a
+        # simulator's /clock keeps moving); then the loops end after their current step and the
+        # executors let go of every entity; only then does the shutdown transition destroy the
+        # plugins' entities, then the nodes and the context. (Destroyed in this thread while a
+        # loop spun, the EventsExecutor lost track of them and aborted the process when it was
+        # freed, one test stop in three: see make_executor.)
         try:
-            state = node.lifecycle_state()
-            if state == "active":
+            if node.lifecycle_state() == "active":
                 node.trigger_deactivate()
-            if node.lifecycle_state() in ("unconfigured", "inactive", "active"):
-                node.trigger_shutdown()
         except Exception as exc:
             self.logger.error(f"controlled stop: {type(exc).__name__}: {exc}")
             code = code or 1
-        # Loops end after their current step; then the executors, then the context.
         for loop in (self.rt_loop, self.nort_loop):
             if loop is not None:
                 loop.stop()
@@ -197,6 +201,12 @@ class EasyNavRuntime:
                 loop.join(timeout=2.0)
         self.rt_executor.shutdown()
         self.nort_executor.shutdown()
+        try:
+            if node.lifecycle_state() in ("unconfigured", "inactive", "active"):
+                node.trigger_shutdown()
+        except Exception as exc:
+            self.logger.error(f"controlled stop: {type(exc).__name__}: {exc}")
+            code = code or 1
         for n in [*node.all_nodes(), node.rt_io_node]:
             n.destroy_node()
         if self.context.ok():

@@ -25,6 +25,13 @@ def make_executor(context: rclpy.Context | None = None):
     entities between calls and is woken by the middleware's events. Same loops, same rates,
     same callbacks in the same threads; the RT loop's timing (bench_rt_loop.py) meets its goal
     with both.
+
+    With the EventsExecutor (rclpy 7.1), shut it down before destroying any entity it serves
+    from another thread: it sets a callback on every entity, and when an entity was destroyed
+    under it (a lifecycle shutdown in the main thread while a loop spins) its bookkeeping
+    breaks ("Couldn't find sub-entities entry for removed Waitable") and, freed with callbacks
+    left, it aborts the process ("Destroying callback manager with callbacks remaining").
+    ``shutdown()`` clears every callback at once, the entities still alive.
     """
     if os.environ.get(EXECUTOR_ENV, "").strip().lower() != "single":
         try:
