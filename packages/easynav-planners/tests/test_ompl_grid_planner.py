@@ -138,6 +138,23 @@ def test_with_radius_shares_the_map_and_bad_arguments_are_named():
         FootprintChecker(Costmap2D(), 0.3)
 
 
+def test_free_regions_join_what_a_moving_disc_can_join():
+    costmap = Costmap2D.filled(100, 60, 0.05)  # 5 m x 3 m
+    costmap.data[:, 48:52] = 254  # a wall across the map at x 2.4..2.6
+    checker = FootprintChecker(costmap, 0.1)
+    left, right = (1.0, 1.5), (4.0, 1.5)
+    assert not checker.connected(left, right)
+    assert checker.region_label(2.5, 1.5) == 0  # inside the wall: no region
+    assert checker.region_extent(2.5, 1.5) is None
+    costmap.data[20:26, 48:52] = 0  # a gap 0.3 m wide: the 0.2 m disc passes, a 0.4 m one not
+    narrow = FootprintChecker(costmap, 0.1)
+    assert narrow.connected(left, right)
+    assert not narrow.with_radius(0.2).connected(left, right)
+    # The box of a region: its free cells' extent (within the radius of the map edge and walls).
+    x0, y0, x1, y1 = FootprintChecker(Costmap2D.filled(100, 60, 0.05), 0.1).region_extent(*left)
+    assert (x0, y0, x1, y1) == pytest.approx((0.1, 0.1, 4.9, 2.9), abs=0.06)
+
+
 def test_polyline_check_finds_a_segment_through_a_wall():
     checker = FootprintChecker(wall_map(), 0.3)
     assert checker.polyline_free(np.array([[2.0, 2.0], [2.0, 5.0]])) == (True, -1)
@@ -179,9 +196,9 @@ def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(
     radii = []
     original = ompl._solve
 
-    def solve(costmap, checker, start, goal):
+    def solve(costmap, checker, start, goal, budget):
         radii.append(checker.radius)
-        return original(costmap, checker, start, goal)
+        return original(costmap, checker, start, goal, budget)
 
     monkeypatch.setattr(ompl, "_solve", solve)
     retried = 0
@@ -192,7 +209,7 @@ def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(
         assert result.ok, result.reason
         assert_clear(costmap, result.poses, 0.30)
         assert radii[0] == pytest.approx(0.15)
-        if len(radii) == 2:
+        if len(radii) >= 2:
             retried += 1
             assert radii[1] == pytest.approx(0.30 + (0.25 + math.sqrt(2.0)) * 0.05)
     assert retried >= 2
@@ -256,14 +273,73 @@ def test_an_anytime_planner_is_repeatable_with_max_iterations():
     assert len(paths[0]) > 0 and np.array_equal(paths[0], paths[1])
 
 
-def test_an_unreachable_goal_is_reported_as_such():
+def test_a_goal_behind_a_closed_wall_is_unreachable_at_once():
     costmap = wall_map()
     costmap.data[160:, 95:105] = 254  # the wall now closes the map
-    result = OMPLGridPlanner(solve_time=0.2, seed=1).plan(costmap, (2.0, 2.0, 0.0),
-                                                           (8.0, 2.0, 0.0))
+    ompl = OMPLGridPlanner(solve_time=LONG, seed=1)
+    result = ompl.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, 0.0))
     assert not result.ok and len(result.poses) == 0
-    assert "goal (8.00, 2.00) is unreachable from (2.00, 2.00)" in result.reason
-    assert "RRTConnect in SE2" in result.reason
+    assert result.reason == (
+        "goal (8.00, 2.00) is unreachable from (2.00, 2.00): no way on the map is wide enough "
+        "for the robot and its clearance (a disc of 0.43 m)"
+    )
+    assert ompl.last_stats.validity_checks == 0  # OMPL never ran: no LONG wait
+
+
+def gap_map(gap: float) -> Costmap2D:
+    """wall_map's wall closed to the top but for a gap ``gap`` m wide at y 6..6+gap."""
+    costmap = wall_map()
+    costmap.data[160:, 95:105] = 254
+    costmap.data[120 : 120 + round(gap / 0.05), 95:105] = 0
+    return costmap
+
+
+@pytest.mark.parametrize(("radius", "passes"), [(0.35, False), (0.15, True)])
+def test_a_gap_is_passed_exactly_when_the_disc_fits_through_it(radius, passes):
+    # A 0.8 m gap: the planning disc is radius + 0.1 clearance + half a cell (0.025 m), so
+    # 0.475 m (0.95 m wide) cannot pass and 0.275 m (0.55 m) can.
+    costmap = gap_map(0.8)
+    ompl = make(seed=2, robot_radius=radius, clearance_distance=0.1)
+    result = ompl.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, 0.0))
+    assert result.ok == passes, result.reason
+    if passes:
+        assert_clear(costmap, result.poses, radius + 0.1)
+        crossing = result.poses[np.argmin(np.abs(result.poses[:, 0] - 5.0)), 1]
+        assert 6.0 < crossing < 6.8  # through the gap
+    else:
+        assert "no way on the map is wide enough" in result.reason
+
+
+def test_ompl_samples_only_the_box_of_the_start_region():
+    # An arena 3 m x 3 m inside a 10 m map free all around it (as a voxel map's projection
+    # leaves the area beyond the walls of a drawn map): every state OMPL draws is in the arena's
+    # box, none in the 91 % of the map outside it.
+    costmap = Costmap2D.filled(200, 200, 0.05)
+    costmap.data[40:44, 40:104] = 254
+    costmap.data[100:104, 40:104] = 254
+    costmap.data[40:104, 40:44] = 254
+    costmap.data[40:104, 100:104] = 254
+    costmap.data[70:74, 44:84] = 254  # a wall inside the arena: plan around its end
+    ompl = make(seed=3, robot_radius=0.15, clearance_distance=0.05)
+    checker = ompl.planning_checker(costmap)
+    x0, y0, x1, y1 = checker.region_extent(2.6, 2.6)
+    r = checker.radius  # the arena's inside, x and y 2.2..5.0, less the disc's radius
+    assert (x0, y0, x1, y1) == pytest.approx((2.2 + r, 2.2 + r, 5.0 - r, 5.0 - r), abs=0.06)
+    drawn = []
+    is_free = checker.is_free
+
+    def recording(x, y):
+        drawn.append((x, y))
+        return is_free(x, y)
+
+    checker.is_free = recording
+    result = ompl.plan(costmap, (2.6, 2.6, 0.0), (2.6, 4.4, 0.0))
+    assert result.ok, result.reason
+    points = np.array(drawn)
+    assert len(points) > 2
+    assert (points[:, 0] >= x0).all() and (points[:, 0] <= x1).all()
+    assert (points[:, 1] >= y0).all() and (points[:, 1] <= y1).all()
+    assert_clear(costmap, result.poses, 0.2)
 
 
 @pytest.mark.parametrize(("space", "yaw"), [("SE2", 0.0), ("ReedsShepp", 0.0), ("Dubins", 3.0)])

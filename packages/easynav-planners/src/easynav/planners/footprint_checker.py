@@ -21,7 +21,10 @@ class FootprintChecker:
     distance transform) minus half a cell diagonal, so a free position never has an obstacle
     cell centre within ``radius`` (the rule the tests check directly).
 
-    Thread contract: immutable after construction; any thread may call it.
+    Free regions (:meth:`connected`, :meth:`region_extent`) are computed on first use: threads
+    racing there compute equal results, one of which is kept.
+
+    Thread contract: immutable after construction (but for that cache); any thread may call it.
     Exceptions: :class:`ValueError` for a radius or cost out of range or an empty costmap.
     """
 
@@ -62,6 +65,7 @@ class FootprintChecker:
         self.free = self.clearance > radius
         # Plain bytes rows for the scalar test OMPL calls per state (faster than numpy scalars).
         self._free_rows = [bytes(row) for row in self.free.astype(np.uint8)]
+        self._regions: tuple[np.ndarray, np.ndarray] | None = None
 
     def with_radius(self, radius: float) -> FootprintChecker:
         """The same map with another disc radius (the distance transform is shared)."""
@@ -133,6 +137,46 @@ class FootprintChecker:
             if not self.are_free(a + t * (b - a)).all():
                 return False, i
         return True, -1
+
+    # -- free regions -----------------------------------------------------------------------------
+    def _labels(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(labels, boxes)``: each free cell's region (8-connected free cells; 0: not free) and
+        each region's cell box ``(ix0, iy0, width, height)``, computed on first use."""
+        if self._regions is None:
+            _, labels, stats, _ = cv2.connectedComponentsWithStats(
+                self.free.astype(np.uint8), connectivity=8, ltype=cv2.CV_32S
+            )
+            self._regions = (labels, stats[:, :4])
+        return self._regions
+
+    def region_label(self, x: float, y: float) -> int:
+        """The free region of the disc at ``(x, y)`` (0 when it is not free).
+
+        A region is a set of free cells joined through edges or corners: a robot moving
+        continuously between two free positions passes only free cells, each next to the one
+        before, so positions in different regions are joined by no free motion at all.
+        """
+        if not self.is_free(x, y):
+            return 0
+        labels, _ = self._labels()
+        return int(labels[int((y - self._oy) * self._inv), int((x - self._ox) * self._inv)])
+
+    def connected(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        """Whether free positions ``a`` and ``b`` lie in the same free region (False when
+        either is not free): without it no motion of the disc joins them."""
+        label = self.region_label(*a)
+        return label != 0 and label == self.region_label(*b)
+
+    def region_extent(self, x: float, y: float) -> tuple[float, float, float, float] | None:
+        """``(x0, y0, x1, y1)`` (m): the box of the cells of the free region of ``(x, y)``,
+        None when it is not free. Every free motion from ``(x, y)`` stays inside it."""
+        label = self.region_label(x, y)
+        if label == 0:
+            return None
+        ix0, iy0, width, height = (int(v) for v in self._labels()[1][label])
+        res = 1.0 / self._inv
+        return (self._ox + ix0 * res, self._oy + iy0 * res,
+                self._ox + (ix0 + width) * res, self._oy + (iy0 + height) * res)
 
     def nearest_obstacle_distance(self, x: float, y: float) -> float:
         """Exact distance (m) from ``(x, y)`` to the nearest obstacle cell centre (inf if none);
