@@ -76,6 +76,25 @@ def test_goes_to_the_first_goal_without_a_path():
     assert_within_limits(run, LIMITS, DT, allow_reverse=False)
 
 
+def test_an_empty_path_stops_the_robot_and_no_path_at_all_leaves_the_goal_as_target():
+    # The planner writes an empty path when it finds no way: driving straight to the goal would
+    # cross what blocked it. A stack without a planner writes no path: the goal is the target.
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", {}, LIMITS, clock)
+    nav_state = NavState()
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    goal = PoseStamped(Header(0.0, "map"), Pose.from_xy_yaw(2.0, 0.0, 0.0))
+    nav_state.set("goals", Goals(Header(0.0, "map"), [goal]))
+    set_path(nav_state, np.zeros((0, 3)))
+    for _ in range(5):
+        clock.t += DT
+        vff.update_rt(nav_state)
+        assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero()
+    nav_state.erase("path")
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0)
+    assert run.arrived
+
+
 def wall_points() -> np.ndarray:
     """A wall across x = 2 from y = 0.1 up to y = 2 (the path passes 0.1 m from its end)."""
     ys = np.arange(0.1, 2.0, 0.05)

@@ -31,7 +31,9 @@ class VffController(ControllerMethodBase):
 
     Target: with ``follow_path`` (default) and a non-empty ``path``, the carrot
     ``look_ahead_dist`` metres along the path beyond the robot's projection, and the path's last
-    pose as the goal; otherwise the first of ``goals`` (the original's only target). Field (see
+    pose as the goal; an empty ``path`` (the planner found no way) is no target: the robot
+    stops. Without ``follow_path``, or with no ``path`` in NavState at all (no planner writes
+    one), the first of ``goals`` (the original's only target). Field (see
     :class:`VffVectors`): attraction towards the target, of length 1 scaled down within
     ``distance_to_goal`` of the goal (approach slow-down), plus repulsion from the nearest point
     of the ungrouped point perceptions inside the ``obstacle_detection_*`` box (robot footprint
@@ -104,12 +106,15 @@ class VffController(ControllerMethodBase):
         """``(carrot xy, goal xy-yaw)`` or None without a target."""
         if self.params.follow_path and nav_state.has(PATH):
             path = nav_state.get(PATH, Path)
-            if len(path):
-                xy_yaw = path.as_xy_yaw()
-                carrot = carrot_on_path(
-                    xy_yaw[:, :2], np.array(pose[:2]), self.params.look_ahead_dist
-                )
-                return carrot, xy_yaw[-1]
+            if not len(path):
+                # The planner found no way (or has not planned yet). The straight line to the
+                # goal would cross what it found in the way, and the field does not see
+                # obstacles within obstacle_detection_x_min: the matrix saw a robot driven
+                # into a pillar of the TurtleBot3 sandbox while its planner failed.
+                return None
+            xy_yaw = path.as_xy_yaw()
+            carrot = carrot_on_path(xy_yaw[:, :2], np.array(pose[:2]), self.params.look_ahead_dist)
+            return carrot, xy_yaw[-1]
         if nav_state.has(GOALS):
             goals = nav_state.get(GOALS, Goals)
             if len(goals):
