@@ -50,6 +50,32 @@ def test_derived_params_handle_flat_keys_and_turn_sim_time_on(tmp_path):
     assert path_topic is None
 
 
+def test_serest_keeps_its_margin_beyond_the_worlds_robot(tmp_path):
+    # d0_margin is from the robot's centre: a file written for the 0.15 m TurtleBot3 (0.20)
+    # would let the campus's 0.3 m robot touch a wall before SeReST stops; a larger one stays.
+    source = tmp_path / "serest.yaml"
+    source.write_text(
+        "controller_node:\n  ros__parameters:\n    controller_types: [a, b, c]\n"
+        "    a: {plugin: easynav_serest_controller/SerestController, d0_margin: 0.2}\n"
+        "    b: {plugin: easynav_serest_controller/SerestController, d0_margin: 0.5}\n"
+        "    c: {plugin: easynav_serest_controller/SerestController}\n"
+    )
+    raised = {}
+    for radius, expected in ((0.3, (0.35, 0.5, 0.35)), (0.15, (0.2, 0.5, 0.3))):
+        out = tmp_path / "out.yaml"
+        notes, _ = derive_params(source, tmp_path / "w.map", (0, 0, 0), out, robot_radius=radius)
+        controllers = yaml.safe_load(out.read_text())["controller_node"]["ros__parameters"]
+        assert tuple(controllers[k].get("d0_margin", 0.3) for k in "abc") == expected
+        raised[radius] = [n for n in notes if "d0_margin" in n]
+    assert raised[0.15] == []
+    assert raised[0.3] == [
+        "controller_node.a.d0_margin 0.2 -> 0.35: the world's robot is 0.3 m (the margin is "
+        "from its centre)",
+        "controller_node.c.d0_margin 0.3 -> 0.35: the world's robot is 0.3 m (the margin is "
+        "from its centre)",
+    ]
+
+
 def test_not_a_params_file_is_refused(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("just: text\n")

@@ -55,6 +55,32 @@ def _ros_parameters(params: dict, node: str) -> dict | None:
     return section.get("ros__parameters")
 
 
+SEREST_CONTROLLER = "easynav_serest_controller/SerestController"
+#: SeReST's default d0_margin (the original's), for an alias that does not set it.
+SEREST_D0_DEFAULT = 0.30
+#: The least room SeReST keeps between the robot's body and an obstacle in the demo (m).
+SEREST_BODY_MARGIN = 0.05
+
+
+def _serest_margin_for_robot(params: dict, robot_radius: float) -> list[str]:
+    """Raise every SerestController alias's ``d0_margin`` to ``robot_radius`` +
+    :data:`SEREST_BODY_MARGIN` where smaller; the notes."""
+    controllers = _ros_parameters(params, "controller_node") or {}
+    floor = round(robot_radius + SEREST_BODY_MARGIN, 6)
+    notes = []
+    for alias in controllers.get("controller_types", []) or []:
+        if _get(controllers, f"{alias}.plugin") != SEREST_CONTROLLER:
+            continue
+        d0 = float(_get(controllers, f"{alias}.d0_margin", SEREST_D0_DEFAULT))
+        if d0 < floor:
+            _set(controllers, f"{alias}.d0_margin", floor)
+            notes.append(
+                f"controller_node.{alias}.d0_margin {d0:g} -> {floor:g}: the world's robot is "
+                f"{robot_radius:g} m (the margin is from its centre)"
+            )
+    return notes
+
+
 def derive_params(
     params_path: Path,
     map_file: Path,
@@ -77,6 +103,9 @@ def derive_params(
     - every localizer alias with an ``initial_pose`` starts at ``start_pose``;
     - ``system_node.robot_geometry.radius`` is ``robot_radius`` and ``.height`` is
       ``robot_height`` when given (the world's robot);
+    - every ``SerestController`` alias keeps ``d0_margin`` (measured from the robot's centre)
+      at least ``robot_radius`` + :data:`SEREST_BODY_MARGIN`: a file written for a smaller
+      robot would let a larger one's body reach the obstacle before SeReST stops;
     - ``use_sim_time: true`` on every node (the playground's /clock is the time).
 
     Returns the notes of what was changed and the planner's debug path topic (None without a
@@ -97,6 +126,8 @@ def derive_params(
         if _get(system, "robot_geometry.radius") != robot_radius:
             _set(system, "robot_geometry.radius", float(robot_radius))
             notes.append(f"system_node.robot_geometry.radius = {robot_radius:g}, the world's robot")
+    if robot_radius is not None:
+        notes.extend(_serest_margin_for_robot(params, float(robot_radius)))
     if robot_height is not None:
         system = params.setdefault("system_node", {}).setdefault("ros__parameters", {})
         if _get(system, "robot_geometry.height") != robot_height:
