@@ -122,6 +122,33 @@ def test_replans_when_the_path_ahead_is_blocked_or_the_robot_strays():
     assert planner.plan_count == 3 and third.as_xy_yaw()[0, :2].tolist() == [1.0, 2.2]
 
 
+def test_a_plan_is_kept_while_the_body_clears_it_and_dropped_when_it_does_not():
+    # Planned with 0.1 m of clearance beyond the 0.25 m body, kept while the body alone fits:
+    # a wall growing into the clearance (noisy cells narrowing a passage) does not drop it.
+    planner = make_planner()
+    nav_state = state_with((7.0, 1.0, 0.0))
+    planner.update(nav_state)
+    path = nav_state.get("path", Path)
+    xy = path.as_xy_yaw()[:, :2]
+    door = xy[np.argmin(np.abs(xy[:, 0] - 4.05))]  # where the path crosses the wall's line
+    narrowed = room()
+    # Cells 0.30 m beside the path at the door: inside the footprint (0.35), clear of the body.
+    ix, iy = (int(v) for v in narrowed.world_to_cell(door[0], door[1] + 0.30))
+    narrowed.data[iy, ix - 3 : ix + 4] = 254
+    nav_state.set("map", narrowed)
+    body, footprint = planner.planner.body_checker(narrowed), planner.planner.checker(narrowed)
+    assert not footprint.polyline_free(xy)[0] and body.polyline_free(xy)[0]
+    planner.update(nav_state)
+    assert nav_state.get("path", Path) is path and planner.plan_count == 1
+    # A cell on the path itself: the body no longer clears it, a new plan.
+    blocked = narrowed.copy()
+    ix, iy = (int(v) for v in blocked.world_to_cell(*xy[len(xy) // 4]))
+    blocked.data[iy, ix] = 254
+    nav_state.set("map", blocked)
+    planner.update(nav_state)
+    assert planner.plan_count == 2 and nav_state.get("path", Path) is not path
+
+
 def test_a_plan_that_starts_with_an_escape_is_kept():
     planner = make_planner()
     # 0.3 m from the wall at x = 4: inside the 0.25 + 0.1 m footprint, the body clear.
