@@ -108,9 +108,9 @@ class VffController(ControllerMethodBase):
             path = nav_state.get(PATH, Path)
             if not len(path):
                 # The planner found no way (or has not planned yet). The straight line to the
-                # goal would cross what it found in the way, and the field does not see
-                # obstacles within obstacle_detection_x_min: the matrix saw a robot driven
-                # into a pillar of the TurtleBot3 sandbox while its planner failed.
+                # goal would cross what it found in the way, and the field's repulsion does not
+                # hold a robot off an obstacle on that line: the matrix saw one driven into a
+                # pillar of the TurtleBot3 sandbox while its planner failed.
                 return None
             xy_yaw = path.as_xy_yaw()
             carrot = carrot_on_path(xy_yaw[:, :2], np.array(pose[:2]), self.params.look_ahead_dist)
