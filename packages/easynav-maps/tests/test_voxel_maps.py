@@ -20,6 +20,7 @@ from easynav.maps.costmap import MAP, MAP_BASE
 from easynav.maps.voxel.bonxai_map import BonxaiMap
 from easynav.maps.voxel.bonxai_maps_manager import BonxaiMapsManager
 from easynav.maps.voxel.keys import MAP_BONXAI
+from easynav.maps.voxel.tracked_key_set import TrackedKeySet
 from easynav.maps.voxel.voxel_projection import band_keys, grid_around, project_keys
 from easynav.maps.voxel.voxel_rays import (
     _ray_keys_kernel,
@@ -183,6 +184,46 @@ def test_band_kept_incrementally_equals_a_full_recompute():
     np.testing.assert_array_equal(np.sort(voxels.band_keys()), np.sort(expected))
     voxels.set_band(0.0, 1.0)  # a taller robot: rebuilt
     expected = band_keys(voxels.occupied_keys(), 0.1, 0.0, 1.0)
+    np.testing.assert_array_equal(np.sort(voxels.band_keys()), np.sort(expected))
+
+
+def test_tracked_key_set_counts_changes_and_keeps_its_array_until_one():
+    band = TrackedKeySet([1, 2])
+    first = band.version
+    array = band.array()
+    assert sorted(array.tolist()) == [1, 2] and not array.flags.writeable
+    band.add_all([2])
+    band.remove_all([7])
+    assert band.version == first and band.array() is array  # nothing changed
+    band.add_all([3])
+    assert band.version != first and sorted(band.array().tolist()) == [1, 2, 3]
+    second = band.version
+    band.remove_all([1])
+    assert band.version not in (first, second) and 1 not in band and len(band) == 2
+    assert TrackedKeySet().version not in (first, second, band.version)  # never repeated
+
+
+@pytest.mark.parametrize("map_class", ["bonxai", "octomap"])
+def test_the_band_version_moves_only_when_the_band_changes(map_class):
+    if map_class == "octomap":
+        pytest.importorskip("pyoctomap")
+        from easynav.maps.voxel.octomap_map import OctomapMap
+
+        voxels = OctomapMap(0.1, 0.2, 0.6)
+    else:
+        voxels = BonxaiMap(0.1)
+        voxels.set_band(0.2, 0.6)
+    # Points inside voxels, not on their faces (where OctoMap's keys and ours may round apart).
+    wall = np.array([[2.05, y, 0.45] for y in np.arange(-0.45, 0.46, 0.1)])
+    origin = np.array([0.05, 0.05, 0.45])
+    voxels.insert_point_cloud(wall, origin)
+    seen = voxels.band_version
+    keys = voxels.band_keys()
+    voxels.insert_point_cloud(wall, origin)  # the same wall again: the same band
+    assert voxels.band_version == seen and voxels.band_keys() is keys
+    voxels.insert_point_cloud(wall - [1.0, 0.0, 0.0], origin)  # a nearer wall
+    assert voxels.band_version != seen
+    expected = band_keys(voxels.occupied_keys(), 0.1, 0.2, 0.6)
     np.testing.assert_array_equal(np.sort(voxels.band_keys()), np.sort(expected))
 
 
@@ -363,6 +404,23 @@ def test_manager_projects_the_shelf_not_the_table_onto_map(tmp_path, manager_cla
     assert nav_state.get(MAP).cost_at(2.02, 1.52) == 254
     if manager_class == "bonxai":
         assert nav_state.get(MAP_BONXAI) is manager.voxel_map
+
+
+def test_the_managers_projection_is_reused_until_the_band_changes(tmp_path):
+    manager = make_manager(BonxaiMapsManager, {"occmap_path_file": str(room_yaml(tmp_path))})
+    nav_state = NavState()
+    manager.update(nav_state)
+    first = manager._band_projection(nav_state.get(MAP))
+    manager.update(nav_state)  # nothing new seen: the same projection, not made again
+    assert manager._band_projection(nav_state.get(MAP)) is first
+    nav_state.set("lidar", PointPerception(shelf_and_table_cloud(), "lidar", 99.0))
+    manager.update(nav_state)  # the shelf: a new band, projected afresh
+    costmap = nav_state.get(MAP)
+    ix, iy = manager._band_projection(costmap)
+    assert ix is not first[0] and costmap.cost_at(1.52, 1.52) == 254
+    direct = project_keys(manager.voxel_map.band_keys(), manager.voxel_map.resolution, costmap)
+    np.testing.assert_array_equal(ix, direct[0])
+    np.testing.assert_array_equal(iy, direct[1])
 
 
 def test_without_insert_perceptions_the_loaded_map_stays_as_it_is(tmp_path):

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from easynav.maps.voxel.tracked_key_set import TrackedKeySet
 from easynav.maps.voxel.voxel_projection import band_keys
 from easynav.maps.voxel.voxel_rays import (
     clip_to_range,
@@ -84,7 +85,7 @@ class BonxaiMap:
         self._observed = np.zeros((0, self._cells), dtype=bool)
         self._coords = np.zeros((0, 3), dtype=np.int64)
         self._band_limits = (0.1, 0.5)
-        self._band: set[int] = set()
+        self._band = TrackedKeySet()
 
     # -- band (the interface the voxel maps managers use) ---------------------------------------
     def set_band(self, min_z: float, max_z: float) -> None:
@@ -92,14 +93,20 @@ class BonxaiMap:
         limits = (float(min_z), float(max_z))
         if limits != self._band_limits:
             self._band_limits = limits
-            self._band = set(
+            self._band = TrackedKeySet(
                 band_keys(self.occupied_keys(), self.resolution, *limits).tolist()
             )
 
     def band_keys(self) -> np.ndarray:
         """Packed keys of the occupied voxels reaching into the band (see :meth:`set_band`),
-        kept up to date by every update: no walk over the whole map per cycle."""
-        return np.fromiter(self._band, dtype=np.int64, count=len(self._band))
+        kept up to date by every update: no walk over the whole map per cycle. Read-only; the
+        same array until the band changes (see :attr:`band_version`)."""
+        return self._band.array()
+
+    @property
+    def band_version(self) -> int:
+        """Changes whenever :meth:`band_keys` would return other keys (never repeats)."""
+        return self._band.version
 
     def _refresh_band(self, keys: np.ndarray, rows: np.ndarray, cells: np.ndarray) -> None:
         inside = _in_band(keys, self.resolution, *self._band_limits)
@@ -107,8 +114,8 @@ class BonxaiMap:
             return
         occupied = self._log_odds[rows[inside], cells[inside]] > self.log_threshold
         chosen = keys[inside]
-        self._band.difference_update(chosen[~occupied].tolist())
-        self._band.update(chosen[occupied].tolist())
+        self._band.remove_all(chosen[~occupied].tolist())
+        self._band.add_all(chosen[occupied].tolist())
 
     # -- size -----------------------------------------------------------------------------------
     @property

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from easynav.maps.voxel.tracked_key_set import TrackedKeySet
 from easynav.maps.voxel.voxel_projection import band_keys
 from easynav.maps.voxel.voxel_rays import (
     clip_to_range,
@@ -54,7 +55,7 @@ class OctomapMap:
         self.tree = _octomap().OcTree(float(resolution))
         self._configure_tree()
         self._band_limits = (float(min_z), float(max_z))
-        self._band: set[int] = set()
+        self._band = TrackedKeySet()
 
     def _configure_tree(self) -> None:
         tree = self.tree
@@ -80,8 +81,14 @@ class OctomapMap:
             self._rebuild_band()
 
     def band_keys(self) -> np.ndarray:
-        """Packed keys of the occupied voxels reaching into the band."""
-        return np.fromiter(self._band, dtype=np.int64, count=len(self._band))
+        """Packed keys of the occupied voxels reaching into the band. Read-only; the same array
+        until the band changes (see :attr:`band_version`)."""
+        return self._band.array()
+
+    @property
+    def band_version(self) -> int:
+        """Changes whenever :meth:`band_keys` would return other keys (never repeats)."""
+        return self._band.version
 
     def _occupied(self, keys: np.ndarray) -> np.ndarray:
         ix, iy, iz = unpack_keys(keys)
@@ -99,12 +106,12 @@ class OctomapMap:
             return
         occupied = self._occupied(keys)
         band = self._band
-        band.difference_update(keys[~occupied].tolist())
-        band.update(keys[occupied].tolist())
+        band.remove_all(keys[~occupied].tolist())
+        band.add_all(keys[occupied].tolist())
 
     def _rebuild_band(self) -> None:
-        self._band = set(band_keys(self.occupied_keys(), self.resolution,
-                                   *self._band_limits).tolist())
+        self._band = TrackedKeySet(band_keys(self.occupied_keys(), self.resolution,
+                                             *self._band_limits).tolist())
 
     # -- updates --------------------------------------------------------------------------------
     def insert_point_cloud(
@@ -141,7 +148,7 @@ class OctomapMap:
         self.tree.updateNodes(centres, float(self.tree.getClampingThresMaxLog()
                                              - self.tree.getClampingThresMinLog()), True)
         self.tree.updateInnerOccupancy()
-        self._band.update(band_keys(keys, res, *self._band_limits).tolist())
+        self._band.add_all(band_keys(keys, res, *self._band_limits).tolist())
 
     # -- queries --------------------------------------------------------------------------------
     def occupied_keys(self) -> np.ndarray:

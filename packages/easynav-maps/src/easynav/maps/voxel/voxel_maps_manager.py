@@ -113,6 +113,8 @@ class VoxelMapsManager(CostmapMapsManager):
         self._inserted: dict[str, float] = {}
         self._last_cloud = -math.inf
         self._cloud_dirty = True
+        self._projection_key: tuple | None = None
+        self._projection: tuple[np.ndarray, np.ndarray] = (np.empty(0, np.int64),) * 2
 
     # -- hooks ----------------------------------------------------------------------------------
     def _new_voxel_map(self, resolution: float) -> Any:
@@ -196,7 +198,7 @@ class VoxelMapsManager(CostmapMapsManager):
         frame = get_tf_buffer(self.context.namespace).get_tf_info().map_frame
         base = Costmap2D(np.zeros_like(grid.data), grid.resolution, grid.origin_x,
                          grid.origin_y, frame, float(self.now()))
-        ix, iy = project_keys(self._voxels.band_keys(), self._voxels.resolution, base)
+        ix, iy = self._band_projection(base)
         base.data[iy, ix] = LETHAL_OBSTACLE
         self._base = base
         self._cloud_dirty = True
@@ -285,7 +287,7 @@ class VoxelMapsManager(CostmapMapsManager):
         nav_state.erase(MAP_OBSTACLE_BOUNDS)
         nav_state.set(MAP_TIME, newest if newest > -math.inf else float(self.now()))
         working = base.copy()
-        ix, iy = project_keys(self._voxels.band_keys(), self._voxels.resolution, working)
+        ix, iy = self._band_projection(working)
         if ix.size:
             working.data[iy, ix] = LETHAL_OBSTACLE
             (x0, x1), (y0, y1) = working.cell_to_world(
@@ -297,6 +299,22 @@ class VoxelMapsManager(CostmapMapsManager):
         working.stamp = float(nav_state.get(MAP_TIME))
         nav_state.set(MAP, working)
         self._publish_dynamic(working)
+
+    def _band_projection(self, grid: Costmap2D) -> tuple[np.ndarray, np.ndarray]:
+        """``(ix, iy)``: the cells of ``grid`` under the band's occupied voxels
+        (:func:`project_keys`), kept while the band and the grid's geometry stay the same: in a
+        static world the band rarely changes once the walls are seen, and projecting it every
+        cycle was most of this manager's CPU. Read-only arrays."""
+        voxels = self._voxels
+        version = getattr(voxels, "band_version", None)
+        key = (version, voxels.resolution, grid.width, grid.height, grid.resolution,
+               grid.origin_x, grid.origin_y)
+        if version is None or key != self._projection_key:
+            ix, iy = project_keys(voxels.band_keys(), voxels.resolution, grid)
+            ix.flags.writeable = False
+            iy.flags.writeable = False
+            self._projection, self._projection_key = (ix, iy), key
+        return self._projection
 
     @staticmethod
     def extend_obstacle_bounds(nav_state: NavState, bounds) -> None:
