@@ -150,9 +150,24 @@ def test_free_regions_join_what_a_moving_disc_can_join():
     narrow = FootprintChecker(costmap, 0.1)
     assert narrow.connected(left, right)
     assert not narrow.with_radius(0.2).connected(left, right)
-    # The box of a region: its free cells' extent (within the radius of the map edge and walls).
+    # The box of a region: its free cells' extent (the radius in from the map edge, here cells
+    # 2..97 and 2..57), a cell wider on every side.
     x0, y0, x1, y1 = FootprintChecker(Costmap2D.filled(100, 60, 0.05), 0.1).region_extent(*left)
-    assert (x0, y0, x1, y1) == pytest.approx((0.1, 0.1, 4.9, 2.9), abs=0.06)
+    assert (x0, y0, x1, y1) == pytest.approx((0.05, 0.05, 4.95, 2.95))
+
+
+def test_a_goal_on_the_edge_of_its_region_is_inside_the_bounds_ompl_samples():
+    # The region's first column starts at -7.55 m, which the grid computes as
+    # -7.549999999999999: a goal at -7.55 was outside OMPL's bounds ("Invalid goal").
+    costmap = Costmap2D.filled(120, 60, 0.05, origin_x=-9.6, origin_y=-1.0)
+    costmap.data[:, 0:36] = 254
+    ompl = OMPLGridPlanner(solve_time=LONG, seed=1, robot_radius=0.1, clearance_distance=0.0)
+    checker = ompl.planning_checker(costmap)
+    goal = (-7.55, 0.5)
+    assert checker.is_free(*goal)
+    assert checker.region_extent(*goal)[0] < goal[0]
+    result = ompl.plan(costmap, (-5.0, 0.5, 0.0), (*goal, 0.0))
+    assert result.ok, result.reason
 
 
 def test_polyline_check_finds_a_segment_through_a_wall():
@@ -209,9 +224,38 @@ def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(
         assert result.ok, result.reason
         assert_clear(costmap, result.poses, 0.30)
         assert radii[0] == pytest.approx(0.15)
-        if len(radii) >= 2:
+        if len(radii) == 2:
             retried += 1
             assert radii[1] == pytest.approx(0.30 + (0.25 + math.sqrt(2.0)) * 0.05)
+    assert retried >= 2
+
+
+def test_without_the_strict_margin_a_refused_path_is_planned_again_from_new_samples(
+        monkeypatch):
+    costmap = wall_map()
+    ompl = make("Dubins", seed=1, robot_radius=0.25, clearance_distance=0.05)
+    verify, _, _ = ompl._checkers(costmap)
+    # Plan with half the radius (shortcuts hug the wall's end), and a strict margin no start
+    # can have (as for a robot close to a wall): the retries use new samples, same radius.
+    loose, impossible = verify.with_radius(0.15), verify.with_radius(50.0)
+    monkeypatch.setattr(ompl, "_checkers", lambda c: (verify, loose, impossible))
+    radii = []
+    original = ompl._solve
+
+    def solve(costmap, checker, start, goal, budget):
+        radii.append(checker.radius)
+        return original(costmap, checker, start, goal, budget)
+
+    monkeypatch.setattr(ompl, "_solve", solve)
+    retried = 0
+    for seed in range(1, 9):
+        ompl.seed = seed
+        radii.clear()
+        result = ompl.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, -math.pi / 2))
+        assert result.ok, result.reason
+        assert_clear(costmap, result.poses, 0.30)
+        assert radii == [pytest.approx(0.15)] * len(radii)
+        retried += len(radii) > 1
     assert retried >= 2
 
 
@@ -323,7 +367,8 @@ def test_ompl_samples_only_the_box_of_the_start_region():
     ompl = make(seed=3, robot_radius=0.15, clearance_distance=0.05)
     checker = ompl.planning_checker(costmap)
     x0, y0, x1, y1 = checker.region_extent(2.6, 2.6)
-    r = checker.radius  # the arena's inside, x and y 2.2..5.0, less the disc's radius
+    # The arena's inside, x and y 2.2..5.0, less the disc's radius, plus a cell.
+    r = checker.radius - 0.05
     assert (x0, y0, x1, y1) == pytest.approx((2.2 + r, 2.2 + r, 5.0 - r, 5.0 - r), abs=0.06)
     drawn = []
     is_free = checker.is_free

@@ -122,9 +122,10 @@ def test_replans_when_the_path_ahead_is_blocked_or_the_robot_strays():
     assert planner.plan_count == 3 and third.as_xy_yaw()[0, :2].tolist() == [1.0, 2.2]
 
 
-def test_a_plan_is_kept_while_the_body_clears_it_and_dropped_when_it_does_not():
-    # Planned with 0.1 m of clearance beyond the 0.25 m body, kept while the body alone fits:
-    # a wall growing into the clearance (noisy cells narrowing a passage) does not drop it.
+def test_a_plan_is_kept_while_half_the_clearance_is_and_dropped_when_it_is_not():
+    # Planned with 0.1 m of clearance beyond the 0.25 m body, kept while the body and half the
+    # clearance fit: a wall growing into the clearance (noisy cells narrowing a passage) does
+    # not drop it.
     planner = make_planner()
     nav_state = state_with((7.0, 1.0, 0.0))
     planner.update(nav_state)
@@ -132,18 +133,30 @@ def test_a_plan_is_kept_while_the_body_clears_it_and_dropped_when_it_does_not():
     xy = path.as_xy_yaw()[:, :2]
     door = xy[np.argmin(np.abs(xy[:, 0] - 4.05))]  # where the path crosses the wall's line
     narrowed = room()
-    # Cells 0.30 m beside the path at the door: inside the footprint (0.35), clear of the body.
-    ix, iy = (int(v) for v in narrowed.world_to_cell(door[0], door[1] + 0.30))
+    # Cells 0.38-0.43 m above the path at the door: within the footprint (0.35 m, the test
+    # conservative by half a cell diagonal), outside the body and half the clearance (0.30 m).
+    ix, iy = (int(v) for v in narrowed.world_to_cell(door[0], door[1] + 0.43))
     narrowed.data[iy, ix - 3 : ix + 4] = 254
     nav_state.set("map", narrowed)
-    body, footprint = planner.planner.body_checker(narrowed), planner.planner.checker(narrowed)
-    assert not footprint.polyline_free(xy)[0] and body.polyline_free(xy)[0]
+    keep, footprint = planner.planner.keep_checker(narrowed), planner.planner.checker(narrowed)
+    assert not footprint.polyline_free(xy)[0] and keep.polyline_free(xy)[0]
     planner.update(nav_state)
     assert nav_state.get("path", Path) is path and planner.plan_count == 1
-    # A cell on the path itself: the body no longer clears it, a new plan.
-    blocked = narrowed.copy()
-    ix, iy = (int(v) for v in blocked.world_to_cell(*xy[len(xy) // 4]))
-    blocked.data[iy, ix] = 254
+    # A cell beside the path, clear of the body but within half the clearance (0.28-0.35 m
+    # away, whichever cell lands there): a new plan.
+    k = len(xy) // 4
+    tangent = (xy[k + 1] - xy[k - 1]) / np.hypot(*(xy[k + 1] - xy[k - 1]))
+    normal = np.array([-tangent[1], tangent[0]])
+    for offset in np.arange(0.28, 0.36, 0.01):
+        blocked = narrowed.copy()
+        ix, iy = (int(v) for v in blocked.world_to_cell(*(xy[k] - offset * normal)))
+        blocked.data[iy, ix] = 254
+        ompl = planner.planner
+        if (ompl.body_checker(blocked).polyline_free(xy)[0]
+                and not ompl.keep_checker(blocked).polyline_free(xy)[0]):
+            break
+    else:
+        pytest.fail("no cell beside the path between the body and half the clearance")
     nav_state.set("map", blocked)
     planner.update(nav_state)
     assert planner.plan_count == 2 and nav_state.get("path", Path) is not path

@@ -169,14 +169,20 @@ class FootprintChecker:
 
     def region_extent(self, x: float, y: float) -> tuple[float, float, float, float] | None:
         """``(x0, y0, x1, y1)`` (m): the box of the cells of the free region of ``(x, y)``,
-        None when it is not free. Every free motion from ``(x, y)`` stays inside it."""
+        a cell wider on every side (within the map); None when it is not free. Every free
+        motion from ``(x, y)`` stays inside it. The extra cell: a point is put in its cell by
+        flooring, so a point of an edge cell may lie a rounding error outside the cells' exact
+        box (-7.55 in a cell whose edge computes as -7.549999999999999), and OMPL refuses a
+        start or goal outside its bounds."""
         label = self.region_label(x, y)
         if label == 0:
             return None
         ix0, iy0, width, height = (int(v) for v in self._labels()[1][label])
-        res = 1.0 / self._inv
+        res = self.costmap.resolution
+        ix1, iy1 = min(ix0 + width + 1, self._w), min(iy0 + height + 1, self._h)
+        ix0, iy0 = max(ix0 - 1, 0), max(iy0 - 1, 0)
         return (self._ox + ix0 * res, self._oy + iy0 * res,
-                self._ox + (ix0 + width) * res, self._oy + (iy0 + height) * res)
+                self._ox + ix1 * res, self._oy + iy1 * res)
 
     def nearest_obstacle_distance(self, x: float, y: float) -> float:
         """Exact distance (m) from ``(x, y)`` to the nearest obstacle cell centre (inf if none);

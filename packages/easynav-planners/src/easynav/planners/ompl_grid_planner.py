@@ -224,6 +224,7 @@ class OMPLGridPlanner:
         self._checker_key: tuple | None = None
         self._planning_checkers: tuple[FootprintChecker, FootprintChecker] | None = None
         self._body: FootprintChecker | None = None
+        self._keep: FootprintChecker | None = None
         self._ompl = import_ompl()
 
     @property
@@ -241,6 +242,13 @@ class OMPLGridPlanner:
         escape segment a path may start with."""
         self._checkers(costmap)
         return self._body
+
+    def keep_checker(self, costmap: Costmap2D) -> FootprintChecker:
+        """The test a plan must still pass to be kept: the body and half the clearance
+        (``robot_radius + clearance_distance / 2``), looser than the one it was planned with,
+        so that a passage narrowed by a noisy cell or two does not drop the plan."""
+        self._checkers(costmap)
+        return self._keep
 
     def planning_checker(self, costmap: Costmap2D) -> FootprintChecker:
         """The test OMPL plans with (half a cell stricter than :meth:`checker`): a start or goal
@@ -271,6 +279,7 @@ class OMPLGridPlanner:
                 verify.with_radius(self.footprint_radius + (0.25 + math.sqrt(2.0)) * res),
             )
             self._body = verify.with_radius(self.robot_radius)
+            self._keep = verify.with_radius(self.robot_radius + 0.5 * self.clearance_distance)
             self._checker_key = key
         return (self._checker, *self._planning_checkers)
 
@@ -376,19 +385,24 @@ class OMPLGridPlanner:
             self._seed_ompl()
             poses, status = self._solve(costmap, planning_checker, start, goal, self.solve_time)
             retry_until = time.perf_counter() + self.solve_time
-            strict_possible = strict_checker.connected(start[:2], goal[:2])
+            strict_tried = False
             while poses is not None and not checker.polyline_free(poses[:, :2])[0]:
                 # The states OMPL checked were clear but a stretch between two of them is not
                 # (see _checkers): plan again, strictly when the start and goal allow it, else
-                # from new random samples (the seed is not set again: a repeatable sequence).
+                # from new random samples (the seed is not set again: a repeatable sequence,
+                # though how many retries fit depends on the clock).
                 left = retry_until - time.perf_counter()
                 if left <= 0.0:
                     break
-                if strict_possible:
+                refused = poses
+                if not strict_tried and strict_checker.connected(start[:2], goal[:2]):
                     poses, status = self._solve(costmap, strict_checker, start, goal, left)
-                    strict_possible = False
                 else:
                     poses, status = self._solve(costmap, planning_checker, start, goal, left)
+                strict_tried = True
+                if poses is None:
+                    poses = refused  # reported below as refused, not as "no path found"
+                    break
         if poses is None:
             return PlanResult(
                 reason=(

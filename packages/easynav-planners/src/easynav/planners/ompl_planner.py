@@ -52,17 +52,18 @@ class OMPLPlanner(PathPlannerBase):
     The robot is a disc of ``system_node.robot_geometry.radius`` + ``clearance_distance``; the
     state space is SE2, Dubins or Reeds–Shepp (``turning_radius``); ``planner`` names the OMPL
     planner, run for at most ``solve_time`` seconds. A plan is kept (and written again each
-    cycle) while the goal is the same, the robot's body (``robot_geometry.radius``, without the
-    clearance the plan was made with) still clears the part of the path ahead of it on the
-    current ``map`` and the robot stays within ``replan_deviation`` of it; otherwise the planner
-    plans again from the robot's pose. An unreachable goal gives an empty path and a WARN
+    cycle) while the goal is the same, the part of the path ahead of the robot keeps the body and
+    half of ``clearance_distance`` off the obstacles of the current ``map`` (planned with all of
+    it) and the robot stays within ``replan_deviation`` of it; otherwise the planner plans again
+    from the robot's pose. An unreachable goal gives an empty path and a WARN
     diagnostic naming it; a goal impossible on the static map (``map.base``: off the map,
     inside or too close to a wall) is rejected (the mission aborts). A path is never written
     unless its interpolated poses, joined by straight segments, are clear of obstacles.
 
     Thread contract: ``initialize`` and runtime parameter changes in the configuring / parameter
     thread while the loops do not run this plugin; ``update`` in the non-RT thread (it blocks it
-    for up to ``solve_time`` when it plans).
+    for up to ``solve_time`` when it plans, twice that when a path found is refused and planned
+    again).
     Exceptions: :class:`PluginConfigurationError` naming the parameter (or the missing ``ompl``
     extra); ``update`` does not raise for unreachable goals (it reports them).
     """
@@ -209,11 +210,12 @@ class OMPLPlanner(PathPlannerBase):
         self.write_path(nav_state, path, f"path of {result.length:.2f} m to {goal_text}")
 
     def _path_still_good(self, costmap: Costmap2D, robot_xy: tuple[float, float]) -> bool:
-        """Whether the robot is near the current path and its body still clears the path ahead.
+        """Whether the robot is near the current path and the path ahead keeps the body and
+        half the clearance off obstacles.
 
-        A path is planned with ``clearance_distance`` and kept while the body alone
-        (``robot_geometry.radius``) clears it: an obstacle on the way drops it, a passage
-        narrowed into the clearance by a few noisy cells does not (seen in the matrix on the
+        A path is planned with ``clearance_distance`` and kept while the body and half of it
+        (:meth:`OMPLGridPlanner.keep_checker`) clear it: an obstacle on or beside the way drops
+        it, a passage narrowed by a noisy cell or two does not (seen in the matrix on the
         TurtleBot3 sandbox: the laser's hits narrowed a pillar passage the robot was driving
         through, and the new plan sent it round three pillars).
         """
@@ -225,4 +227,12 @@ class OMPLPlanner(PathPlannerBase):
         # The first pose about as near as the nearest: with cusps (Reeds–Shepp) a path passes
         # near the same place twice, and the earlier pass is the one still ahead.
         ahead = int(np.argmax(distance <= nearest + 0.1))
-        return self.planner.body_checker(costmap).polyline_free(xy[ahead:])[0]
+        keep = self.planner.keep_checker(costmap)
+        # A path may start with an escape out of the clearance, which only the body clears.
+        clear = keep.are_free(xy[ahead:])
+        escape = int(np.argmax(clear)) if clear.any() else len(clear) - 1
+        body = self.planner.body_checker(costmap)
+        return (
+            body.polyline_free(xy[ahead : ahead + escape + 1])[0]
+            and keep.polyline_free(xy[ahead + escape :])[0]
+        )
