@@ -107,10 +107,11 @@ class VffController(ControllerMethodBase):
         if self.params.follow_path and nav_state.has(PATH):
             path = nav_state.get(PATH, Path)
             if not len(path):
-                # The planner found no way (or has not planned yet). The straight line to the
-                # goal would cross what it found in the way, and the field's repulsion does not
-                # hold a robot off an obstacle on that line: the matrix saw one driven into a
-                # pillar of the TurtleBot3 sandbox while its planner failed.
+                # The planner found no way. (Before its first plan there is no path at all,
+                # and the first goal is the target for that cycle or two.) The straight line
+                # to the goal would cross what it found in the way, and the field's repulsion
+                # does not hold a robot off an obstacle on that line: the matrix saw one driven
+                # into a pillar of the TurtleBot3 sandbox while its planner failed.
                 return None
             xy_yaw = path.as_xy_yaw()
             carrot = carrot_on_path(xy_yaw[:, :2], np.array(pose[:2]), self.params.look_ahead_dist)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import yaml
 
+from easynav.controllers.serest_tracker import SEREST_DEFAULTS
 from easynav.system.cli.params_file import load_ros_yaml
 
 SIMPLE_MAPS_MANAGER = "easynav_simple_maps_manager/SimpleMapsManager"
@@ -57,7 +58,7 @@ def _ros_parameters(params: dict, node: str) -> dict | None:
 
 SEREST_CONTROLLER = "easynav_serest_controller/SerestController"
 #: SeReST's default d0_margin (the original's), for an alias that does not set it.
-SEREST_D0_DEFAULT = 0.30
+SEREST_D0_DEFAULT = SEREST_DEFAULTS["d0_margin"]
 #: The least room SeReST keeps between the robot's body and an obstacle in the demo (m).
 SEREST_BODY_MARGIN = 0.05
 
