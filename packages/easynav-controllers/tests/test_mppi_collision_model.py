@@ -112,6 +112,15 @@ def test_a_robot_inside_the_margin_may_move_along_or_away_not_closer():
                           held=0.15).threshold == pytest.approx(0.15)
     later = CollisionModel(costmap, (0.84, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=model.held)
     assert later.threshold == pytest.approx(0.16 - INSIDE_MARGIN_SLACK, abs=1e-4)
+    # Moving as near as the hold allows does not move the hold: no creeping in, a hair's
+    # breadth a cycle (each cycle the robot goes to the hold, 0.17 m, and a little beyond it
+    # by the field's rounding).
+    hold = model.held
+    for _ in range(20):
+        nearest = 0.82 + (0.18 - hold) - 0.001  # 1 mm short of the hold
+        cycle = CollisionModel(costmap, (nearest, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=hold)
+        assert cycle.held == pytest.approx(model.held)
+        hold = cycle.held
     # Out of the margin again: released.
     assert CollisionModel(costmap, (0.5, 0.0, 0.0), 1.0, 0.15, 0.05, True,
                           held=0.15).held is None
