@@ -201,14 +201,18 @@ def test_every_returned_path_is_clear_of_obstacles(space, planner):
     assert spacing.max() <= 0.1 + 1e-6  # interpolated every interpolation_step
 
 
-def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(monkeypatch):
+def plans_past_the_wall_with(monkeypatch, strict_radius: float | None) -> list[list[float]]:
+    """Eight seeded Dubins plans past wall_map's wall end, OMPL planning with half the radius
+    (0.15 m: its shortcuts hug the wall's end) and the strict margin of ``strict_radius`` (None:
+    the planner's own); every result clear of the true 0.30 m. The radii of each plan's solves."""
     costmap = wall_map()
     ompl = make("Dubins", seed=1, robot_radius=0.25, clearance_distance=0.05)
     verify, _, strict = ompl._checkers(costmap)
-    # Plan first with half the radius: shortcuts then hug the wall's end too closely.
     loose = verify.with_radius(0.15)
+    if strict_radius is not None:
+        strict = verify.with_radius(strict_radius)
     monkeypatch.setattr(ompl, "_checkers", lambda c: (verify, loose, strict))
-    radii = []
+    radii: list[float] = []
     original = ompl._solve
 
     def solve(costmap, checker, start, goal, budget):
@@ -216,47 +220,33 @@ def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(
         return original(costmap, checker, start, goal, budget)
 
     monkeypatch.setattr(ompl, "_solve", solve)
-    retried = 0
+    per_plan = []
     for seed in range(1, 9):
         ompl.seed = seed
         radii.clear()
         result = ompl.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, -math.pi / 2))
         assert result.ok, result.reason
         assert_clear(costmap, result.poses, 0.30)
-        assert radii[0] == pytest.approx(0.15)
-        if len(radii) == 2:
-            retried += 1
-            assert radii[1] == pytest.approx(0.30 + (0.25 + math.sqrt(2.0)) * 0.05)
-    assert retried >= 2
+        per_plan.append(list(radii))
+    return per_plan
+
+
+def test_a_path_failing_the_final_check_is_planned_again_with_the_strict_margin(monkeypatch):
+    per_plan = plans_past_the_wall_with(monkeypatch, None)
+    assert all(radii[0] == pytest.approx(0.15) for radii in per_plan)
+    retried = [radii for radii in per_plan if len(radii) == 2]
+    assert len(retried) >= 2
+    strict = 0.30 + (0.25 + math.sqrt(2.0)) * 0.05
+    assert all(radii[1] == pytest.approx(strict) for radii in retried)
 
 
 def test_without_the_strict_margin_a_refused_path_is_planned_again_from_new_samples(
         monkeypatch):
-    costmap = wall_map()
-    ompl = make("Dubins", seed=1, robot_radius=0.25, clearance_distance=0.05)
-    verify, _, _ = ompl._checkers(costmap)
-    # Plan with half the radius (shortcuts hug the wall's end), and a strict margin no start
-    # can have (as for a robot close to a wall): the retries use new samples, same radius.
-    loose, impossible = verify.with_radius(0.15), verify.with_radius(50.0)
-    monkeypatch.setattr(ompl, "_checkers", lambda c: (verify, loose, impossible))
-    radii = []
-    original = ompl._solve
-
-    def solve(costmap, checker, start, goal, budget):
-        radii.append(checker.radius)
-        return original(costmap, checker, start, goal, budget)
-
-    monkeypatch.setattr(ompl, "_solve", solve)
-    retried = 0
-    for seed in range(1, 9):
-        ompl.seed = seed
-        radii.clear()
-        result = ompl.plan(costmap, (2.0, 2.0, 0.0), (8.0, 2.0, -math.pi / 2))
-        assert result.ok, result.reason
-        assert_clear(costmap, result.poses, 0.30)
-        assert radii == [pytest.approx(0.15)] * len(radii)
-        retried += len(radii) > 1
-    assert retried >= 2
+    # A strict margin no start can have (as for a robot close to a wall): the retries draw new
+    # samples with the same radius.
+    per_plan = plans_past_the_wall_with(monkeypatch, 50.0)
+    assert all(radii == [pytest.approx(0.15)] * len(radii) for radii in per_plan)
+    assert sum(len(radii) > 1 for radii in per_plan) >= 2
 
 
 def test_se2_poses_face_the_next_one_and_the_last_has_the_goal_yaw():
