@@ -432,11 +432,70 @@ def test_impossible_goals_and_starts_are_named(goal, start, words):
         ({"seed": -1}, "seed"),
         ({"obstacle_cost": 300}, "obstacle_cost"),
         ({"planner": "PRM", "max_iterations": 10}, "second thread"),
+        ({"preferred_clearance": -0.1}, "preferred_clearance"),
     ],
 )
 def test_bad_parameters_are_named(kwargs, words):
     with pytest.raises(ValueError, match=words):
         OMPLGridPlanner(**kwargs)
+
+
+def pillars_map() -> Costmap2D:
+    """6 m x 4 m at 0.05 m: two 0.8 m square pillars (x 2.1..2.9; y 0.8..1.6 and 2.4..3.2), a
+    0.8 m passage between them."""
+    costmap = Costmap2D.filled(120, 80, 0.05)
+    costmap.data[16:32, 42:58] = 254
+    costmap.data[48:64, 42:58] = 254
+    return costmap
+
+
+def body_distances(costmap: Costmap2D, xy: np.ndarray) -> np.ndarray:
+    """Distance (m) from each point to the nearest obstacle cell centre (brute force)."""
+    centres = obstacle_centres(costmap)
+    return np.hypot(xy[:, None, 0] - centres[None, :, 0], xy[:, None, 1] - centres[None, :, 1]
+                    ).min(axis=1)
+
+
+def test_preferred_clearance_moves_se2_paths_off_the_pillars_they_round():
+    # Diagonally through the 0.8 m passage between two pillars: the shortest path cuts from the
+    # lower pillar's corner to the upper one's at the footprint (0.25 m, the planning margin
+    # adds a little). Centred (0.35 m wanted beyond the 0.15 m body: more than the passage has)
+    # it crosses the passage along its middle, straight, and keeps more room everywhere.
+    costmap = pillars_map()
+    start, goal = (1.2, 1.2, 0.0), (3.8, 2.8, 0.0)
+    shortest = make(seed=1, robot_radius=0.15, clearance_distance=0.1).plan(
+        costmap, start, goal)
+    centred = make(seed=1, robot_radius=0.15, clearance_distance=0.1,
+                   preferred_clearance=0.35).plan(costmap, start, goal)
+    assert shortest.ok and centred.ok
+    assert_clear(costmap, centred.poses, 0.25)
+    near = body_distances(costmap, shortest.poses[:, :2]).min()
+    assert near < 0.35
+    # The middle of the passage is 0.4 m from the pillars' faces, 0.425 m from their cells'
+    # centres.
+    poses = centred.poses
+    passage = np.abs(poses[:, 0] - 2.5) < 0.4
+    assert passage.sum() >= 7
+    assert np.abs(poses[passage, 1] - 2.0).max() < 0.01
+    assert np.abs(poses[passage, 2]).max() < 0.05  # no zigzag: every pose faces along it
+    assert body_distances(costmap, poses[:, :2]).min() > near + 0.05
+    # The poses are still interpolation_step apart at most, SE2 poses facing the next one.
+    xy = poses[:, :2]
+    assert np.hypot(*np.diff(xy, axis=0).T).max() <= 0.1 + 1e-9
+    d = np.diff(xy, axis=0)
+    np.testing.assert_allclose(poses[:-1, 2], np.arctan2(d[:, 1], d[:, 0]))
+    assert xy[0].tolist() == [1.2, 1.2] and xy[-1].tolist() == [3.8, 2.8]
+
+
+def test_preferred_clearance_leaves_car_paths_and_the_shortest_setting_alone():
+    costmap = pillars_map()
+    start, goal = (1.5, 0.5, 0.0), (4.5, 3.5, 0.0)
+    for space, preferred in (("Dubins", 0.35), ("ReedsShepp", 0.35), ("SE2", 0.1)):
+        plain = make(space, seed=1, robot_radius=0.15, clearance_distance=0.1).plan(
+            costmap, start, goal)
+        moved = make(space, seed=1, robot_radius=0.15, clearance_distance=0.1,
+                     preferred_clearance=preferred).plan(costmap, start, goal)
+        np.testing.assert_array_equal(plain.poses, moved.poses)
 
 
 def test_every_planner_offered_finds_a_path_in_se2():

@@ -16,6 +16,7 @@ import numpy as np
 
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
 from easynav.planners.footprint_checker import FootprintChecker
+from easynav.planners.path_centering import ClearanceField, center_path
 from easynav.planners.plan_result import PlanResult
 
 #: State spaces: SE2 (x, y, yaw; straight lines, the yaw turns on the spot), Dubins (forward
@@ -135,7 +136,13 @@ class OMPLGridPlanner:
     when ``max_iterations`` > 0, at most that many iterations); ``range`` > 0 sets the planners'
     maximum extension (OMPL's default otherwise). With ``simplify`` the solution is shortened
     (OMPL's PathSimplifier, to convergence), then interpolated every ``interpolation_step``
-    metres along the motion.
+    metres along the motion. A shortened path rounds every corner as close as the footprint
+    allows, and a follower that cuts corners clips them: in SE2, with ``preferred_clearance``
+    > ``clearance_distance``, the path is then moved away from obstacles until the robot keeps
+    ``preferred_clearance`` beyond its radius, where the room allows (the middle of narrower
+    passages; see :func:`center_path`), and kept as it was if the moved path fails the
+    footprint test. Dubins and Reeds–Shepp paths are not moved (that would break their turning
+    radius).
 
     Before OMPL runs, the free region of the start (the free cells joined to it, see
     :meth:`FootprintChecker.connected`) decides two things. A goal outside it is unreachable
@@ -180,6 +187,7 @@ class OMPLGridPlanner:
         allow_unknown: bool = False,
         max_iterations: int = 0,
         range: float = 0.0,  # noqa: A002 - OMPL's name for the extension length
+        preferred_clearance: float = 0.0,
     ) -> None:
         if state_space not in STATE_SPACES:
             raise ValueError(f"state_space = {state_space!r} must be one of {STATE_SPACES}")
@@ -219,12 +227,14 @@ class OMPLGridPlanner:
             )
         self.max_iterations = int(max_iterations)
         self.range = _positive("range", range, allow_zero=True)
+        self.preferred_clearance = _positive("preferred_clearance", preferred_clearance, True)
         self.last_stats = PlanStats()
         self._checker: FootprintChecker | None = None
         self._checker_key: tuple | None = None
         self._planning_checkers: tuple[FootprintChecker, FootprintChecker] | None = None
         self._body: FootprintChecker | None = None
         self._keep: FootprintChecker | None = None
+        self._field: ClearanceField | None = None
         self._ompl = import_ompl()
 
     @property
@@ -280,6 +290,9 @@ class OMPLGridPlanner:
             )
             self._body = verify.with_radius(self.robot_radius)
             self._keep = verify.with_radius(self.robot_radius + 0.5 * self.clearance_distance)
+            self._field = ClearanceField(
+                verify.clearance, costmap.origin_x, costmap.origin_y, res
+            )
             self._checker_key = key
         return (self._checker, *self._planning_checkers)
 
@@ -541,10 +554,28 @@ class OMPLGridPlanner:
         # OMPL shares the count out between segments by their length in its metric (with the
         # yaw in SE2), rounding per segment: split the few poses still too far apart.
         poses = densify(poses, self.interpolation_step)
+        if self.state_space == "SE2" and self.preferred_clearance > self.clearance_distance:
+            poses = self._centred(poses)
         self.last_stats = PlanStats(
             text, solved_at - began, simplified_at - solved_at, counter[0], raw_states
         )
         return self._finish(poses, start, goal), text
+
+    def _centred(self, poses: np.ndarray) -> np.ndarray:
+        """``poses`` moved to ``preferred_clearance`` where there is room (SE2; the yaws are
+        set by :meth:`_finish`), or as they were if the moved path fails the footprint test."""
+        xy = center_path(
+            poses[:, :2],
+            self._field,
+            self.robot_radius + self.preferred_clearance,
+            self.interpolation_step,
+        )
+        if not self._checker.polyline_free(xy)[0]:
+            return poses
+        out = np.zeros((len(xy), 3))
+        out[:, :2] = xy
+        out[-1, 2] = poses[-1, 2]
+        return out
 
     def _finish(self, poses: np.ndarray, start, goal) -> np.ndarray:
         # Repeated positions (a turn on the spot in SE2) carry no direction for a follower.

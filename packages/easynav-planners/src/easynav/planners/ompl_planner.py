@@ -29,6 +29,7 @@ _PLANNER_PARAMETERS = (
     "allow_unknown",
     "max_iterations",
     "range",
+    "preferred_clearance",
 )
 
 
@@ -89,6 +90,9 @@ class OMPLPlanner(PathPlannerBase):
               ge=0),
         Param("range", 0.0, "maximum extension of tree planners (0: OMPL's default)", "m",
               ge=0.0),
+        Param("preferred_clearance", 0.3, "where there is room, the path (SE2) is moved this far "
+              "from obstacles beyond the robot radius; at most clearance_distance: the "
+              "shortest path", "m", ge=0.0),
         Param("replan_deviation", 0.5, "replan when the robot is farther than this from the path",
               "m", gt=0.0),
     )
@@ -123,6 +127,7 @@ class OMPLPlanner(PathPlannerBase):
             allow_unknown=values["allow_unknown"],
             max_iterations=values["max_iterations"],
             range=values["range"],
+            preferred_clearance=values["preferred_clearance"],
         )
 
     def configure_planner(self) -> None:
