@@ -398,6 +398,27 @@ def test_a_robot_inside_the_clearance_escapes_along_a_segment_its_body_clears(sp
     assert_clear(costmap, poses[first_clear:], 0.40)
 
 
+def test_a_robot_escapes_to_the_side_its_goal_is_on():
+    # A thin wall across the map at y = 2 with a 0.6 m gap (x 2.7..3.3): the 0.5 m body passes,
+    # the 0.7 m footprint does not, so the two halves are separate free regions. The robot
+    # stands in the gap, a little south of the wall's line, facing along it: the nearest point
+    # to plan from is south; the goal is north, so it escapes north through the gap.
+    costmap = Costmap2D.filled(120, 80, 0.05)
+    costmap.data[40, :] = 254
+    costmap.data[40, 54:66] = 0
+    robot, goal = (3.0, 1.97, 0.0), (3.0, 3.5, 0.0)
+    ompl = make(seed=1, robot_radius=0.25, clearance_distance=0.1)
+    planning = ompl.planning_checker(costmap)
+    assert not planning.connected((3.0, 1.0), goal[:2])
+    nearest = ompl.escape_point(costmap, *robot)
+    assert nearest is not None and nearest[1] < 2.0
+    result = ompl.plan(costmap, robot, goal)
+    assert result.ok, result.reason
+    assert result.poses[0, :2].tolist() == [3.0, 1.97]
+    assert (result.poses[1:, 1] > 1.97).all()  # northwards from the first step
+    assert_clear(costmap, result.poses, 0.25)
+
+
 def test_a_robot_touching_an_obstacle_has_no_escape():
     result = make(seed=1).plan(wall_map(), (4.55, 4.0, 0.0), (2.0, 2.0, 0.0))
     assert not result.ok and "start (4.55, 4.00) is closer than" in result.reason

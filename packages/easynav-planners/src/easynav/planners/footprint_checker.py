@@ -149,6 +149,11 @@ class FootprintChecker:
             self._regions = (labels, stats[:, :4])
         return self._regions
 
+    def region_labels(self) -> np.ndarray:
+        """Each cell's free region (``(height, width)``, 0 where the disc is not free); see
+        :meth:`region_label`."""
+        return self._labels()[0]
+
     def region_label(self, x: float, y: float) -> int:
         """The free region of the disc at ``(x, y)`` (0 when it is not free).
 

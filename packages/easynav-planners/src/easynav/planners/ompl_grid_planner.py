@@ -297,17 +297,30 @@ class OMPLGridPlanner:
         return (self._checker, *self._planning_checkers)
 
     def escape_point(
-        self, costmap: Costmap2D, x: float, y: float, yaw: float
+        self,
+        costmap: Costmap2D,
+        x: float,
+        y: float,
+        yaw: float,
+        goal: tuple[float, float] | None = None,
     ) -> tuple[float, float] | None:
         """Where a robot that stands inside the clearance of an obstacle (its body clear of it)
         gets out: the nearest point OMPL may start from within :data:`ESCAPE_DISTANCE`, first
         straight ahead or behind along its heading (ahead only for Dubins), else in any
-        direction, reached by a straight segment its body (``robot_radius``) clears. None when
-        the body itself touches an obstacle or no such point is in reach."""
+        direction, reached by a straight segment its body (``robot_radius``) clears. With a
+        ``goal`` (x, y), only points in the goal's free region count: the nearest point may lie
+        in a pocket no path leaves, such as a gap between two boxes. None when the body itself
+        touches an obstacle or no such point is in reach."""
         self._checkers(costmap)
         body, planning = self._body, self._planning_checkers[0]
         if not body.is_free(x, y):
             return None
+        wanted = planning.region_label(*goal) if goal is not None else 0
+
+        def usable(px: float, py: float) -> bool:
+            label = planning.region_label(px, py)
+            return label != 0 and (wanted == 0 or label == wanted)
+
         step = 0.5 * costmap.resolution
         headings = [(math.cos(yaw), math.sin(yaw))]
         if self.state_space != "Dubins":
@@ -315,7 +328,7 @@ class OMPLGridPlanner:
         for d in np.arange(step, ESCAPE_DISTANCE + 1e-9, step):
             for ux, uy in headings:
                 px, py = x + d * ux, y + d * uy
-                if planning.is_free(px, py) and body.polyline_free(
+                if usable(px, py) and body.polyline_free(
                     np.array([[x, y], [px, py]])
                 )[0]:
                     return float(px), float(py)
@@ -323,8 +336,8 @@ class OMPLGridPlanner:
         reach = math.ceil(ESCAPE_DISTANCE / costmap.resolution)
         cx, cy = (int(v) for v in costmap.world_to_cell(x, y))
         x0, y0 = max(cx - reach, 0), max(cy - reach, 0)
-        window = planning.free[y0 : cy + reach + 1, x0 : cx + reach + 1]
-        iy, ix = np.nonzero(window)
+        labels = planning.region_labels()[y0 : cy + reach + 1, x0 : cx + reach + 1]
+        iy, ix = np.nonzero(labels == wanted if wanted else labels)
         px, py = costmap.cell_to_world(ix + x0, iy + y0)
         distance = np.hypot(px - x, py - y)
         for k in np.argsort(distance)[:50]:
@@ -376,7 +389,7 @@ class OMPLGridPlanner:
         ):
             # A robot that drifted into the clearance of a wall plans from the nearest clear
             # point, reached by a straight segment its body clears (as SimplePlanner escapes).
-            point = self.escape_point(costmap, *start)
+            point = self.escape_point(costmap, *start, goal=goal[:2])
             if point is not None:
                 start = (point[0], point[1], start[2])
         if problem is None:
