@@ -63,6 +63,31 @@ def test_follows_the_path_and_stops_at_the_goal(make_path, deviation):
     assert_within_limits(run, LIMITS, DT, allow_reverse=False)
 
 
+@pytest.mark.parametrize("yaw", [math.pi / 2, -math.pi / 2, 3.0])
+def test_facing_away_from_the_path_it_turns_on_the_spot_before_driving(yaw):
+    # At a waypoint facing its yaw, the next path leaves at right angles (or behind). Driving
+    # while turning swung the robot 0.29 m off such a path into a pillar (the TurtleBot3
+    # sandbox); turned on the spot first, it stays within 8 cm of it (the last half of the
+    # turn is driven).
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", {}, LIMITS, clock)
+    nav_state = NavState()
+    path = straight_path()
+    set_path(nav_state, path)
+    run = run_closed_loop(vff, nav_state, clock, start=(0.0, 0.0, yaw), dt=DT, t_max=60.0)
+    assert run.arrived
+    first_move = next(i for i, (v, _) in enumerate(run.commands) if v > 0.0)
+    heading = run.poses[first_move][2]
+    assert abs(math.remainder(heading, 2 * math.pi)) <= 0.785  # turned most of the way first
+    assert max(distance_to_path(path, px, py) for px, py, _ in run.poses) <= 0.08
+    # pi: the cosine rule alone, as before: it drives while turning and swings off the path.
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", {"rotate_to_heading_min_angle": math.pi}, LIMITS,
+                      clock)
+    run = run_closed_loop(vff, nav_state, clock, start=(0.0, 0.0, yaw), dt=DT, t_max=60.0)
+    assert max(distance_to_path(path, px, py) for px, py, _ in run.poses) > 0.25
+
+
 def test_goes_to_the_first_goal_without_a_path():
     clock = Clock()
     vff = make_plugin(VffController, "vff", {"follow_path": False}, LIMITS, clock)

@@ -22,6 +22,10 @@ from easynav.core.types import Goals, Header, Odometry, Path, Twist, TwistStampe
 FOLLOWING, ALIGNING, ARRIVED, NO_GOAL = "following", "aligning", "arrived", "no_goal"
 
 
+#: A commanded speed (m/s) below which the robot counts as standing (see update_rt).
+STANDSTILL = 0.01
+
+
 def _wrap(angle: float) -> float:
     return math.atan2(math.sin(angle), math.cos(angle))
 
@@ -37,10 +41,16 @@ class VffController(ControllerMethodBase):
     :class:`VffVectors`): attraction towards the target, of length 1 scaled down within
     ``distance_to_goal`` of the goal (approach slow-down), plus repulsion from the nearest point
     of the ungrouped point perceptions inside the ``obstacle_detection_*`` box (robot footprint
-    frame) nearer than ``distance_obstacle_detection``. Within the goal tolerance
-    (``goal_tolerance.*``, else ``fallback_goal_*``) it stops and turns to the goal yaw, then
-    commands zero (the original never stopped by itself). Commands are kept within the limits in
-    force (``get_robot_limits()``, every cycle), speeds and accelerations.
+    frame) nearer than ``distance_obstacle_detection``. The resultant's angle is the turn rate
+    and its length, times the cosine of that angle, the speed. Starting from a standstill with
+    the target more than ``rotate_to_heading_min_angle`` off the heading, the robot first turns
+    on the spot towards it, until it lies within half of that: driving while turning through a
+    large angle swings it off the path (0.29 m measured, into a pillar of the TurtleBot3
+    sandbox's 0.8 m passages, leaving a waypoint on a path at right angles to its yaw). Within
+    the goal tolerance (``goal_tolerance.*``, else ``fallback_goal_*``) it stops and turns to
+    the goal yaw, then commands zero (the original never stopped by itself). Commands are kept
+    within the limits in force (``get_robot_limits()``, every cycle), speeds and
+    accelerations.
 
     NavState: reads ``path``, ``goals``, ``robot_pose``, ``goal_tolerance.position|yaw``,
     ungrouped point perceptions; writes ``cmd_vel`` (node clock stamp, robot footprint frame;
@@ -69,6 +79,10 @@ class VffController(ControllerMethodBase):
         Param("follow_path", True, "attract to a carrot on `path` (false: to the first goal, as "
               "the original)"),
         Param("look_ahead_dist", 0.6, "carrot distance along the path", "m", gt=0.0),
+        Param("rotate_to_heading_min_angle", 0.785, "from a standstill, turn on the spot while "
+              "the target lies more than this off the heading, until within half of it (pi: "
+              "never)", "rad",
+              gt=0.0, le=math.pi),
         Param("fallback_goal_pos_tol", 0.05, "position tolerance when goal_tolerance.position "
               "is absent", "m", gt=0.0),
         Param("fallback_goal_yaw_tol", 0.05, "yaw tolerance when goal_tolerance.yaw is absent",
@@ -87,6 +101,7 @@ class VffController(ControllerMethodBase):
         self._last_time: float | None = None
         self._last = (0.0, 0.0)
         self._aligning = False
+        self._turning = False
 
     def on_initialize(self) -> None:
         self.reset()
@@ -97,6 +112,7 @@ class VffController(ControllerMethodBase):
         self._last_time = None
         self._last = (0.0, 0.0)
         self._aligning = False
+        self._turning = False
 
     def limits(self) -> RobotLimits:
         """The limits in force (``get_robot_limits()``), read every cycle."""
@@ -205,6 +221,20 @@ class VffController(ControllerMethodBase):
                 attraction,
             )
             v, w = self.vectors.command(limits.max_linear_vel, limits.max_angular_vel)
+            # From a standstill (a new leg, the robot still facing the last waypoint's yaw) with
+            # the target far off the heading, turn on the spot towards it until it lies within
+            # half the angle: a circular robot turning on the spot touches nothing. Not once
+            # moving: near an obstacle the repulsion turns the robot away from its target, and
+            # stopping to turn back held a robot passing a wall's end at a crawl.
+            off = _wrap(bearing - pose[2])
+            threshold = self.params.rotate_to_heading_min_angle
+            if self._turning:
+                self._turning = abs(off) > 0.5 * threshold
+            else:
+                self._turning = abs(self._last[0]) < STANDSTILL and abs(off) > threshold
+            if self._turning:
+                v = 0.0
+                w = min(max(off, -limits.max_angular_vel), limits.max_angular_vel)
         v, w = limit_command(v, w, *self._last, dt, limits, allow_reverse=False)
         self._last = (v, w)
         self._write(nav_state, now, v, w)
