@@ -21,7 +21,7 @@ from easynav.controllers.mppi.savitzky_golay import savgol_coefficients, smooth_
 from easynav.controllers.regulated_pp.path_geometry import project_on_path
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
-from easynav.core.robot import RobotLimits
+from easynav.core.robot import RobotGeometry, RobotLimits
 from easynav.core.types import (
     INSCRIBED_INFLATED_OBSTACLE,
     LETHAL_OBSTACLE,
@@ -49,15 +49,17 @@ class Clock:
         return self.t
 
 
-def make_controller(params=None, limits=LIMITS):
+def make_controller(params=None, limits=LIMITS, radius=None):
     values = {"mppi.rt_freq": 20.0, "mppi.seed": 7}
     values.update({f"mppi.{k}": v for k, v in (params or {}).items()})
     holder = {"limits": limits}
+    geometry = RobotGeometry() if radius is None else RobotGeometry(radius=radius)
     context = PluginContext(
         parameters=DictParameters(values),
         namespace=f"mppi_test_{next(_namespaces)}",
         now=Clock(),
         robot_limits=lambda: holder["limits"],
+        robot_geometry=lambda: geometry,
     )
     controller = MPPIController()
     controller.initialize(context, "mppi")
@@ -399,6 +401,79 @@ def test_brakes_when_every_candidate_collides():
     assert command.state == "blocked"
     assert command.v == pytest.approx(0.4 - 1.0 * 0.05) and command.w == 0.0
     assert not optimizer.sequence.any()
+
+
+def test_stopped_with_every_candidate_colliding_it_turns_on_the_spot_towards_the_path():
+    # Stopped where every sample collides (here: on inscribed cells, as after a localisation
+    # jump), its path leading north. Braking with no turn left such a robot blocked for good
+    # (against a pillar of the TurtleBot3 sandbox, facing it); it turns left, on the spot,
+    # towards the path.
+    costmap = Costmap2D.filled(100, 100, 0.05, -2.5, -2.5)
+    ix, iy = (int(v) for v in costmap.world_to_cell(0.0, 0.0))
+    costmap.data[iy - 4 : iy + 5, ix - 4 : ix + 5] = INSCRIBED_INFLATED_OBSTACLE
+    limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0,
+                         max_angular_acc=1.0)
+    # (Without the rotation to the path's heading, which would turn it before MPPI runs.)
+    controller = make_controller({**NAV2_SIZE, "use_rotate_to_heading": False}, limits=limits)
+    optimizer = controller.optimizer
+    north = straight_path(2.0)[:, [1, 0, 2]] * np.array([-1.0, 1.0, 0.0]) + [0, 0, math.pi / 2]
+    command = optimizer.compute((0.0, 0.0, 0.0), north, 0.05, limits, 0.15, 0.15, costmap,
+                                path_key=1)
+    assert command.state == "blocked"
+    assert command.v == 0.0 and command.w == pytest.approx(1.0 * 0.05)  # accelerating left
+    # Moving, it brakes first, without turning (test_brakes_when_every_candidate_collides).
+
+
+def test_a_rollout_cutting_across_a_bend_does_not_reach_the_path_beyond_it():
+    # The path from the robot (0.5, 0) runs east 0.5 m, north 0.6 m, west 1 m. A rollout driving
+    # 0.6 m north ends on the west leg, 1.6 m along the path: it cannot have got that far along
+    # it, so it reaches the nearest point within its 0.6 m travelled (+ 0.2 m of slack).
+    path = u_turn_path()
+    path = path[10:]  # from (0.5, 0)
+    s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path[:, :2], axis=0).T))))
+    vx = [[0.6] * 10, [0.4] * 10]
+    wz = [[0.0] * 10, [0.0] * 10]
+    north = make_batch(vx, wz, pose=(0.5, 0.0, math.pi / 2), path=path, goal=(0.0, 0.6, math.pi))
+    ends = np.column_stack((north.x[:, -1], north.y[:, -1]))
+    assert ends[0] == pytest.approx([0.5, 0.6], abs=1e-5)
+    distance = np.hypot(*(path[None, :, :2] - ends[:, None]).T).T
+    assert s[int(np.argmin(distance[0]))] == pytest.approx(1.6)  # nearest point overall
+    allowed = s <= 0.6 + 0.2 + 1e-6
+    expected = max(int(np.argmin(np.where(allowed, distance[0], np.inf))),
+                   int(np.argmin(np.where(s <= 0.4 + 0.2 + 1e-6, distance[1], np.inf))))
+    assert north.furthest_reached_index() == expected
+    assert s[expected] <= 0.8 + 1e-6
+
+
+def test_follows_a_path_that_turns_round_a_pillar_between_pillars():
+    # The TurtleBot3 sandbox's pillars (radius 0.18 m, 1.1 m apart, 0.74 m passages) and a
+    # path that leaves a passage round the pillar ahead on its left: west between two rows,
+    # south round the pillar, east to the goal. The path-follow critic pulled the robot
+    # across that pillar (rollouts through it "reached" the path beyond it), and the robot
+    # stopped against it; a 0.15 m robot now gets round without touching a pillar.
+    pillars = [(x, y) for x in (0.0, 1.0, 2.1) for y in (0.0, -1.1)]
+    costmap = inflated_costmap(pillars, radius=0.18, inscribed=0.15, inflation=0.7)
+    corners = np.array([[2.8, -0.55], [0.45, -0.55], [0.45, -1.65], [1.55, -1.65]])
+    pieces = [np.linspace(a, b, max(2, int(np.hypot(*(b - a)) / 0.05)))[:-1]
+              for a, b in zip(corners[:-1], corners[1:], strict=True)]
+    xy = np.vstack(pieces + [corners[-1:]])
+    yaw = np.arctan2(np.diff(xy[:, 1], append=xy[-1, 1]), np.diff(xy[:, 0], append=xy[-1, 0]))
+    yaw[-1] = 0.0
+    limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0,
+                         max_linear_acc=0.5, max_linear_decel=1.0, max_angular_acc=1.0,
+                         max_angular_decel=2.0)
+    controller = make_controller(NAV2_SIZE, limits=limits, radius=0.15)
+    nav_state = NavState()
+    nav_state.set("map", costmap)
+    nav_state.set("goal_tolerance.position", 0.15)
+    nav_state.set("goal_tolerance.yaw", 0.3)
+    poses, commands, states = run_closed_loop(controller, np.column_stack((xy, yaw)),
+                                              (2.8, -0.55, math.pi), steps=1200,
+                                              nav_state=nav_state)
+    assert states[-1] == "arrived"
+    nearest = min(np.hypot(poses[:, 0] - px, poses[:, 1] - py).min() for px, py in pillars)
+    assert nearest - 0.18 > 0.15  # the robot's disc never touched a pillar
+    assert_within_limits(commands, limits)
 
 
 def u_turn_path(step=0.05):

@@ -11,6 +11,11 @@ from easynav.controllers.mppi.collision_model import CollisionModel
 from easynav.core.robot import RobotLimits
 from easynav.core.types import Costmap2D
 
+#: How much farther along the path than a rollout travelled (m) its end may count as reaching
+#: (see :meth:`MppiBatch.furthest_reached_index`): the robot may stand a little off the path,
+#: ahead of its projection.
+PROGRESS_SLACK = 0.2
+
 
 @dataclass(slots=True)
 class MppiBatch:
@@ -76,10 +81,18 @@ class MppiBatch:
         return int(self.vx.shape[1])
 
     def furthest_reached_index(self) -> int:
-        """Index of the local-path point nearest to any rollout's end (the furthest one).
+        """Index of the local-path point nearest to any rollout's end (the furthest one),
+        among the points no farther along the path than that rollout travelled (plus
+        :data:`PROGRESS_SLACK`).
 
         Computed once per batch (Nav2's "furthest reached path point"): the critics that look
-        ahead of it (path align, path follow, path angle) share it.
+        ahead of it (path align, path follow, path angle) share it. The arc-length bound (as
+        Nav2 since 2026) keeps a rollout that cuts across a bend of the path from "reaching"
+        the path beyond the bend: where the path turns round an obstacle, a rollout driven
+        through the obstacle ends next to the path behind it, and the path-follow critic then
+        pulled every rollout towards that point, across the obstacle (seen on the TurtleBot3
+        sandbox: the robot left the passage between two pillars towards the one the path
+        turned round, and stopped against it).
         """
         if self._furthest is None:
             if len(self.path_xy) <= 1:
@@ -92,5 +105,10 @@ class MppiBatch:
                     - 2.0 * ends @ path.T
                     + np.sum(path * path, axis=1)[None, :]
                 )
+                travelled = np.abs(self.vx).sum(axis=1, dtype=np.float32) * np.float32(self.dt)
+                beyond = self.path_s.astype(np.float32)[None, :] > (
+                    travelled[:, None] + np.float32(PROGRESS_SLACK))
+                beyond[:, 0] = False  # the robot's projection is always reachable
+                d2[beyond] = np.inf
                 self._furthest = int(np.argmin(d2, axis=1).max())
         return self._furthest
