@@ -425,24 +425,23 @@ def test_stopped_with_every_candidate_colliding_it_turns_on_the_spot_towards_the
 
 
 def test_a_rollout_cutting_across_a_bend_does_not_reach_the_path_beyond_it():
-    # The path from the robot (0.5, 0) runs east 0.5 m, north 0.6 m, west 1 m. A rollout driving
-    # 0.6 m north ends on the west leg, 1.6 m along the path: it cannot have got that far along
-    # it, so it reaches the nearest point within its 0.6 m travelled (+ 0.2 m of slack).
-    path = u_turn_path()
-    path = path[10:]  # from (0.5, 0)
-    s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path[:, :2], axis=0).T))))
-    vx = [[0.6] * 10, [0.4] * 10]
-    wz = [[0.0] * 10, [0.0] * 10]
-    north = make_batch(vx, wz, pose=(0.5, 0.0, math.pi / 2), path=path, goal=(0.0, 0.6, math.pi))
-    ends = np.column_stack((north.x[:, -1], north.y[:, -1]))
-    assert ends[0] == pytest.approx([0.5, 0.6], abs=1e-5)
-    distance = np.hypot(*(path[None, :, :2] - ends[:, None]).T).T
-    assert s[int(np.argmin(distance[0]))] == pytest.approx(1.6)  # nearest point overall
-    allowed = s <= 0.6 + 0.2 + 1e-6
-    expected = max(int(np.argmin(np.where(allowed, distance[0], np.inf))),
-                   int(np.argmin(np.where(s <= 0.4 + 0.2 + 1e-6, distance[1], np.inf))))
-    assert north.furthest_reached_index() == expected
-    assert s[expected] <= 0.8 + 1e-6
+    # The path from the robot (0.5, 0) runs east 0.5 m, north 0.6 m, west 1 m, a point every
+    # 0.05 m. A rollout driving 0.57 m north ends at (0.5, 0.57), next to the west leg's point
+    # (0.5, 0.6) (index 32, 1.6 m along the path): it cannot have got that far along, so it
+    # reaches only the points within its 0.57 m travelled + 0.2 m, the nearest of which is the
+    # robot's own (index 0). A rollout driving 0.37 m east ends at (0.87, 0): index 7 (0.85, 0).
+    path = u_turn_path()[10:]  # from (0.5, 0)
+    assert path[0, :2].tolist() == [0.5, 0.0] and path[32, :2] == pytest.approx([0.5, 0.6])
+    vx = [[0.57] * 10, [0.0] * 10]
+    north = make_batch(vx, [[0.0] * 10] * 2, pose=(0.5, 0.0, math.pi / 2), path=path,
+                       goal=(0.0, 0.6, math.pi))
+    assert (north.x[0, -1], north.y[0, -1]) == pytest.approx((0.5, 0.57), abs=1e-5)
+    assert north.furthest_reached_index() == 0
+    both = make_batch([[0.57] * 10, [0.37] * 10], [[0.0] * 10] * 2, path=path,
+                      pose=(0.5, 0.0, math.pi / 2), goal=(0.0, 0.6, math.pi))
+    both.x[1], both.y[1] = both.y[1] + 0.5, both.x[1] - 0.5  # the second rollout drives east
+    assert (both.x[1, -1], both.y[1, -1]) == pytest.approx((0.87, 0.0), abs=1e-5)
+    assert both.furthest_reached_index() == 7
 
 
 def test_follows_a_path_that_turns_round_a_pillar_between_pillars():

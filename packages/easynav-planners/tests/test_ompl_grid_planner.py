@@ -508,6 +508,12 @@ def test_preferred_clearance_moves_se2_paths_off_the_pillars_they_round():
     assert xy[0].tolist() == [1.2, 1.2] and xy[-1].tolist() == [3.8, 2.8]
 
 
+def test_a_map_one_cell_high_gives_a_reason_not_an_exception():
+    result = make(seed=1, preferred_clearance=0.3).plan(
+        Costmap2D.filled(50, 1, 0.05), (0.5, 0.02, 0.0), (2.0, 0.02, 0.0))
+    assert not result.ok and "closer than robot_radius" in result.reason
+
+
 def test_preferred_clearance_leaves_car_paths_and_the_shortest_setting_alone():
     costmap = pillars_map()
     start, goal = (1.5, 0.5, 0.0), (4.5, 3.5, 0.0)
@@ -516,6 +522,7 @@ def test_preferred_clearance_leaves_car_paths_and_the_shortest_setting_alone():
             costmap, start, goal)
         moved = make(space, seed=1, robot_radius=0.15, clearance_distance=0.1,
                      preferred_clearance=preferred).plan(costmap, start, goal)
+        assert plain.ok and moved.ok, (space, plain.reason, moved.reason)
         np.testing.assert_array_equal(plain.poses, moved.poses)
 
 

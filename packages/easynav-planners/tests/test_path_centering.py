@@ -1,27 +1,27 @@
-"""center_path and ClearanceField without ROS, against direct computations."""
+"""center_path and ClearanceGradient without ROS, against direct computations."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from easynav.planners.path_centering import ClearanceField, center_path, resample
+from easynav.planners.path_centering import ClearanceGradient, center_path, resample
 
 
-def corridor_field(width: float = 1.0, res: float = 0.05) -> ClearanceField:
+def corridor_field(width: float = 1.0, res: float = 0.05) -> ClearanceGradient:
     """A corridor along x, ``width`` wide between walls at y = 0 and y = width: the clearance
     of a cell centre is its distance to the nearer wall."""
     rows = round(width / res)
     y = (np.arange(rows) + 0.5) * res
     clearance = np.minimum(y, width - y)[:, None] * np.ones((1, 120))
-    return ClearanceField(clearance, 0.0, 0.0, res)
+    return ClearanceGradient(clearance, 0.0, 0.0, res)
 
 
 def test_the_field_interpolates_a_linear_clearance_and_its_gradient_exactly():
     res = 0.1
     iy, ix = np.mgrid[0:20, 0:30]
     x, y = (ix + 0.5) * res - 1.0, (iy + 0.5) * res + 2.0
-    field = ClearanceField(0.3 * x - 0.2 * y + 1.0, -1.0, 2.0, res)
+    field = ClearanceGradient(0.3 * x - 0.2 * y + 1.0, -1.0, 2.0, res)
     points = np.array([[-0.73, 2.41], [0.12, 3.07], [1.5, 3.2]])
     value, grad = field.at(points)
     np.testing.assert_allclose(value, 0.3 * points[:, 0] - 0.2 * points[:, 1] + 1.0)
@@ -62,7 +62,7 @@ def test_a_path_rounding_a_pillar_keeps_its_side_and_gains_the_wanted_clearance(
     res = 0.05
     iy, ix = np.mgrid[0:80, 0:120]
     x, y = (ix + 0.5) * res - 3.0, (iy + 0.5) * res - 2.0
-    field = ClearanceField(np.hypot(x, y), -3.0, -2.0, res)
+    field = ClearanceGradient(np.hypot(x, y), -3.0, -2.0, res)
     t = np.linspace(-2.5, 2.5, 51)
     xy = np.column_stack([t, 0.3 + 0.5 * (np.abs(t) > 1.0) * (np.abs(t) - 1.0)])
     out = center_path(xy, field, wanted=0.6, step=0.1)
@@ -80,3 +80,8 @@ def test_a_path_rounding_a_pillar_keeps_its_side_and_gains_the_wanted_clearance(
 def test_short_paths_in_the_middle_come_back_resampled(xy, expected):
     out = center_path(xy, corridor_field(), wanted=0.6, step=0.1)
     np.testing.assert_allclose(out, expected, atol=1e-12)
+
+
+def test_a_grid_too_small_for_a_gradient_is_refused():
+    with pytest.raises(ValueError, match="no gradient"):
+        ClearanceGradient(np.zeros((1, 5)), 0.0, 0.0, 0.05)

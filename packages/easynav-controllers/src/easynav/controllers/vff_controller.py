@@ -11,6 +11,7 @@ from easynav.common.tf import get_tf_buffer
 from easynav.controllers.command_limits import limit_command
 from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW
 from easynav.controllers.path_follower import carrot_on_path
+from easynav.controllers.regulated_pp.regulation import latched_angle
 from easynav.controllers.vff_vectors import VffVectors
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, GOALS, PATH, ROBOT_POSE
@@ -43,14 +44,14 @@ class VffController(ControllerMethodBase):
     of the ungrouped point perceptions inside the ``obstacle_detection_*`` box (robot footprint
     frame) nearer than ``distance_obstacle_detection``. The resultant's angle is the turn rate
     and its length, times the cosine of that angle, the speed. Starting from a standstill with
-    the target more than ``rotate_to_heading_min_angle`` off the heading, the robot first turns
-    on the spot towards it, until it lies within half of that: driving while turning through a
-    large angle swings it off the path (0.29 m measured, into a pillar of the TurtleBot3
-    sandbox's 0.8 m passages, leaving a waypoint on a path at right angles to its yaw). Within
-    the goal tolerance (``goal_tolerance.*``, else ``fallback_goal_*``) it stops and turns to
-    the goal yaw, then commands zero (the original never stopped by itself). Commands are kept
-    within the limits in force (``get_robot_limits()``, every cycle), speeds and
-    accelerations.
+    the target (and the field) more than ``rotate_to_heading_min_angle`` off the heading, the
+    robot first turns on the spot towards it, until it lies within half of that: driving while
+    turning through a large angle swings it off the path (0.29 m measured, into a pillar of the
+    TurtleBot3 sandbox's 0.8 m passages, leaving a waypoint on a path at right angles to its
+    yaw). Within the goal tolerance (``goal_tolerance.*``, else ``fallback_goal_*``) it stops
+    and turns to the goal yaw, then commands zero (the original never stopped by itself).
+    Commands are kept within the limits in force (``get_robot_limits()``, every cycle), speeds
+    and accelerations.
 
     NavState: reads ``path``, ``goals``, ``robot_pose``, ``goal_tolerance.position|yaw``,
     ungrouped point perceptions; writes ``cmd_vel`` (node clock stamp, robot footprint frame;
@@ -102,6 +103,7 @@ class VffController(ControllerMethodBase):
         self._last = (0.0, 0.0)
         self._aligning = False
         self._turning = False
+        self._turn_sign = 0.0  # the latch of the turn on the spot near +-pi
 
     def on_initialize(self) -> None:
         self.reset()
@@ -113,6 +115,7 @@ class VffController(ControllerMethodBase):
         self._last = (0.0, 0.0)
         self._aligning = False
         self._turning = False
+        self._turn_sign = 0.0  # the latch of the turn on the spot near +-pi
 
     def limits(self) -> RobotLimits:
         """The limits in force (``get_robot_limits()``), read every cycle."""
@@ -222,16 +225,22 @@ class VffController(ControllerMethodBase):
             )
             v, w = self.vectors.command(limits.max_linear_vel, limits.max_angular_vel)
             # From a standstill (a new leg, the robot still facing the last waypoint's yaw) with
-            # the target far off the heading, turn on the spot towards it until it lies within
-            # half the angle: a circular robot turning on the spot touches nothing. Not once
-            # moving: near an obstacle the repulsion turns the robot away from its target, and
-            # stopping to turn back held a robot passing a wall's end at a crawl.
+            # the target and the field far off the heading, turn on the spot towards the target
+            # until it lies within half the angle: a circular robot turning on the spot touches
+            # nothing. Not once moving: near an obstacle the repulsion turns the robot away from
+            # its target, and stopping to turn back held a robot passing a wall's end at a
+            # crawl. Nor while the field points ahead (the repulsion holding the robot's heading
+            # off its target), for the same reason.
             off = _wrap(bearing - pose[2])
             threshold = self.params.rotate_to_heading_min_angle
             if self._turning:
+                off = latched_angle(off, self._turn_sign)
                 self._turning = abs(off) > 0.5 * threshold
             else:
-                self._turning = abs(self._last[0]) < STANDSTILL and abs(off) > threshold
+                field = math.atan2(self.vectors.result[1], self.vectors.result[0])
+                self._turning = (abs(self._last[0]) < STANDSTILL and abs(off) > threshold
+                                 and abs(field) > threshold)
+            self._turn_sign = (1.0 if off >= 0.0 else -1.0) if self._turning else 0.0
             if self._turning:
                 v = 0.0
                 w = min(max(off, -limits.max_angular_vel), limits.max_angular_vel)

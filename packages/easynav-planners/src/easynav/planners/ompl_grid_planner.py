@@ -16,7 +16,7 @@ import numpy as np
 
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
 from easynav.planners.footprint_checker import FootprintChecker
-from easynav.planners.path_centering import ClearanceField, center_path
+from easynav.planners.path_centering import ClearanceGradient, center_path
 from easynav.planners.plan_result import PlanResult
 
 #: State spaces: SE2 (x, y, yaw; straight lines, the yaw turns on the spot), Dubins (forward
@@ -142,7 +142,8 @@ class OMPLGridPlanner:
     ``preferred_clearance`` beyond its radius, where the room allows (the middle of narrower
     passages; see :func:`center_path`), and kept as it was if the moved path fails the
     footprint test. Dubins and Reeds–Shepp paths are not moved (that would break their turning
-    radius).
+    radius). ``preferred_clearance`` is 0 here (the shortest path); the plugin's default is
+    0.3 m.
 
     Before OMPL runs, the free region of the start (the free cells joined to it, see
     :meth:`FootprintChecker.connected`) decides two things. A goal outside it is unreachable
@@ -234,7 +235,7 @@ class OMPLGridPlanner:
         self._planning_checkers: tuple[FootprintChecker, FootprintChecker] | None = None
         self._body: FootprintChecker | None = None
         self._keep: FootprintChecker | None = None
-        self._field: ClearanceField | None = None
+        self._gradient: tuple[tuple | None, ClearanceGradient | None] = (None, None)
         self._ompl = import_ompl()
 
     @property
@@ -290,9 +291,6 @@ class OMPLGridPlanner:
             )
             self._body = verify.with_radius(self.robot_radius)
             self._keep = verify.with_radius(self.robot_radius + 0.5 * self.clearance_distance)
-            self._field = ClearanceField(
-                verify.clearance, costmap.origin_x, costmap.origin_y, res
-            )
             self._checker_key = key
         return (self._checker, *self._planning_checkers)
 
@@ -577,9 +575,19 @@ class OMPLGridPlanner:
     def _centred(self, poses: np.ndarray) -> np.ndarray:
         """``poses`` moved to ``preferred_clearance`` where there is room (SE2; the yaws are
         set by :meth:`_finish`), or as they were if the moved path fails the footprint test."""
+        key, gradient = self._gradient
+        if key != self._checker_key:
+            # Built on first use for each costmap: only SE2 plans with centring need it.
+            clearance = self._checker.clearance
+            gradient = None if min(clearance.shape) < 2 else ClearanceGradient(
+                clearance, self._checker.origin_x, self._checker.origin_y,
+                self._checker.costmap.resolution)
+            self._gradient = (self._checker_key, gradient)
+        if gradient is None:
+            return poses  # a map one cell wide: nothing to centre in
         xy = center_path(
             poses[:, :2],
-            self._field,
+            gradient,
             self.robot_radius + self.preferred_clearance,
             self.interpolation_step,
         )

@@ -8,9 +8,11 @@ middle of a passage narrower than twice that) while a smoothing term keeps the p
 kinking; the ends stay where they are.
 
 The push follows the gradient of a clearance field (metres to the nearest obstacle, per cell),
-so a pose never crosses an obstacle: the path keeps its way round every obstacle. Only the part
-normal to the path is applied, so poses do not bunch along it; the path is resampled at the
-end. It is plain numpy (a few hundred poses, tens of vectorised iterations: about a millisecond).
+so it moves poses away from obstacles, not across them; the smoothing and the final resampling
+are not bounded by the field, so the caller checks the result (and keeps its own path if the
+moved one fails). Only the part of the push normal to the path is applied, so poses do not
+bunch along it; the path is resampled at the end. It is plain numpy (a few hundred poses,
+tens of vectorised iterations: about a millisecond).
 """
 
 from __future__ import annotations
@@ -41,17 +43,20 @@ def resample(xy: np.ndarray, step: float) -> np.ndarray:
     return out
 
 
-class ClearanceField:
+class ClearanceGradient:
     """Bilinear clearance (m) and its gradient over a grid of cell values.
 
     ``clearance[iy, ix]`` is the clearance at the centre of cell ``(ix, iy)`` of a grid whose
-    lower-left corner is ``(origin_x, origin_y)`` and cells ``resolution`` metres wide.
+    lower-left corner is ``(origin_x, origin_y)`` and cells ``resolution`` metres wide, at least
+    2 x 2 cells (:class:`ValueError` otherwise: there is no gradient).
     """
 
     def __init__(
         self, clearance: np.ndarray, origin_x: float, origin_y: float, resolution: float
     ) -> None:
         self.values = np.asarray(clearance, dtype=np.float64)
+        if self.values.ndim != 2 or min(self.values.shape) < 2:
+            raise ValueError(f"a clearance grid of shape {self.values.shape} has no gradient")
         self.origin = (float(origin_x), float(origin_y))
         self.resolution = float(resolution)
         gy, gx = np.gradient(self.values, self.resolution)
@@ -84,7 +89,7 @@ class ClearanceField:
 
 def center_path(
     xy: np.ndarray,
-    field: ClearanceField,
+    field: ClearanceGradient,
     wanted: float,
     step: float,
     smoothing: float = SMOOTHING,

@@ -211,6 +211,7 @@ class MppiOptimizer:
         self._at_goal_xy = False
         self._rotating = False
         self._rotation_sign = 0.0
+        self._blocked_sign = 0.0  # the latch of the turn in place when blocked
         self._held: float | None = None  # the CollisionModel's hold inside the margin
         self.last_batch: MppiBatch | None = None
 
@@ -286,12 +287,9 @@ class MppiOptimizer:
         path_xy, path_yaw, path_s, is_final = self._local_path(
             np.array((x0, y0)), rollout_reach + PATH_MARGIN)
         if p["use_rotate_to_heading"]:
-            ahead = min(int(np.searchsorted(path_s, p["rotate_to_heading_lookahead_dist"])),
-                        len(path_xy) - 1)
-            tx, ty = path_xy[ahead]
-            angle = normalize_angle(math.atan2(ty - y0, tx - x0) - yaw0)
+            angle, far = self._angle_to_path_ahead(pose, path_xy, path_yaw, path_s)
             threshold = p["rotate_to_heading_min_angle"] * (0.5 if self._rotating else 1.0)
-            if math.hypot(tx - x0, ty - y0) > 1e-3 and abs(angle) > threshold:
+            if far and abs(angle) > threshold:
                 self._rotating = True
                 angle = self._latch(angle)
                 self.sequence[:] = 0.0
@@ -365,8 +363,9 @@ class MppiOptimizer:
         # Refusing it for that held a robot between the TurtleBot3 sandbox's pillars at a
         # crawl (fallback to the best sample, accelerating 0.025 m/s a cycle, the mean refused
         # again); the next cycles optimise again before the robot gets there.
-        guard = min(steps, max(1, math.ceil(
-            (max_v / max(limits.max_linear_decel, 1e-3) + GUARD_REACTION) / dt)))
+        # (From the current speed when it is higher: a speed zone may just have lowered max_v.)
+        braking = max(max_v, abs(self.last[0])) / max(limits.max_linear_decel, 1e-3)
+        guard = min(steps, max(1, math.ceil((braking + GUARD_REACTION) / dt)))
         if collision is not None and collision.rollout_collides(ox[0, :guard], oy[0, :guard]):
             # The weighted mean of collision-free samples (two ways round an obstacle) may
             # itself collide: fall back to the best sample, held within the accelerations.
@@ -387,21 +386,34 @@ class MppiOptimizer:
                     # touches nothing). A robot stopped facing an obstacle beside its path
                     # finds every sample colliding (each drives some way ahead first) and,
                     # not turning, stayed blocked for good: seen against a pillar of the
-                    # TurtleBot3 sandbox.
-                    ahead = min(int(np.searchsorted(path_s, p["rotate_to_heading_lookahead_dist"])),
-                                len(path_xy) - 1)
-                    tx, ty = path_xy[ahead]
-                    angle = normalize_angle(math.atan2(ty - y0, tx - x0) - yaw0) if math.hypot(
-                        tx - x0, ty - y0) > 1e-3 else normalize_angle(path_yaw[0] - yaw0)
+                    # TurtleBot3 sandbox. Latched near ±pi, as the other turns in place.
+                    angle, _far = self._angle_to_path_ahead(pose, path_xy, path_yaw, path_s)
+                    angle = latched_angle(angle, self._blocked_sign)
+                    self._blocked_sign = 1.0 if angle >= 0.0 else -1.0
                     w = rotation_speed(angle, self.last[1], elapsed, max_w,
                                        limits.max_angular_acc, limits.max_angular_decel, max_w)
                 return self._apply(v, w, BLOCKED)
+            self._blocked_sign = 0.0
             state = FALLBACK
+        else:
+            self._blocked_sign = 0.0
         self.sequence[:, 0] = v_seq[0]
         self.sequence[:, 1] = w_seq[0]
         self.last_batch = batch
         optimal = np.column_stack((ox[0], oy[0], oyaw[0]))
         return self._apply(float(v_seq[0, 0]), float(w_seq[0, 0]), state, optimal)
+
+    def _angle_to_path_ahead(self, pose, path_xy, path_yaw, path_s) -> tuple[float, bool]:
+        """The angle from the robot's heading to the local-path point
+        ``rotate_to_heading_lookahead_dist`` ahead (to the path's yaw at the robot when that
+        point is the robot's own position), and whether the point is away from the robot."""
+        x0, y0, yaw0 = pose
+        ahead = min(int(np.searchsorted(path_s, self.params["rotate_to_heading_lookahead_dist"])),
+                    len(path_xy) - 1)
+        tx, ty = path_xy[ahead]
+        if math.hypot(tx - x0, ty - y0) > 1e-3:
+            return normalize_angle(math.atan2(ty - y0, tx - x0) - yaw0), True
+        return normalize_angle(path_yaw[0] - yaw0), False
 
     def _latch(self, angle: float) -> float:
         # Keep turning the way a rotation in place started while the target is near ±π.
