@@ -100,8 +100,8 @@ def center_path(
     Each iteration moves every inner pose, at once, by the part normal to the path of
     ``min(wanted - clearance, half a cell)`` along the clearance gradient (nothing where the
     clearance is already ``wanted``), plus ``smoothing`` times its offset from the midpoint of
-    its neighbours. Where the room is narrower than ``2 * wanted`` the pose settles in the middle,
-    within half a cell (the gradient flips there). The caller checks the result against its
+    its neighbours. Where the room is narrower than ``2 * wanted`` the pose settles in the middle
+    (the gradient fades to nothing there). The caller checks the result against its
     collision rule: the push raises the clearance of every pose, but the smoothing may lower it
     where the path bends round a corner narrower than ``wanted``.
     """
@@ -125,8 +125,8 @@ def center_path(
         push -= np.sum(push * tangent, axis=1)[:, None] * tangent
         midpoint = 0.5 * (points[:-2] + points[2:])
         moved = inner + push + smoothing * (midpoint - inner)
-        if np.max(np.abs(moved - inner)) < 1e-4:
-            points[1:-1] = moved
-            break
+        settled = np.max(np.abs(moved - inner)) < 1e-4
         points[1:-1] = moved
+        if settled:
+            break
     return resample(points, step)
