@@ -296,6 +296,23 @@ def test_avoids_an_obstacle_placed_on_the_path(offset):
     assert_within_limits(commands)
 
 
+def test_stops_before_a_wall_of_an_occupancy_grid_map():
+    # The simple maps manager writes a SimpleMap (boolean cells) in `map`, not a Costmap2D:
+    # MPPI read no obstacles there, and in the matrix drove into a pillar of the TurtleBot3
+    # sandbox. A wall across the path: it stops short of it.
+    from test_map_as_costmap import OccupancyCells
+
+    cells = np.zeros((50, 60), dtype=bool)
+    cells[:, 25] = True  # x in [1.5, 1.6)
+    nav_state = NavState()
+    nav_state.set("map", OccupancyCells(cells, resolution=0.1, origin_x=-1.0, origin_y=-2.5))
+    controller = make_controller(NAV2_SIZE, radius=0.2)
+    poses, _, _ = run_closed_loop(controller, straight_path(3.0), (0.0, 0.0, 0.0), steps=300,
+                                  nav_state=nav_state)
+    assert poses[:, 0].max() < 1.5 - 0.2
+    assert abs(poses[-1, 0] - poses[-40, 0]) < 0.02  # standing there
+
+
 def test_limits_in_force_each_cycle_and_deprecated_caps():
     controller = make_controller({"max_linear_velocity": 0.3})
     _poses, commands, _states = run_closed_loop(controller, straight_path(), (0.0, 0.0, 0.0),

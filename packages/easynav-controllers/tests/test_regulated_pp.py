@@ -257,6 +257,24 @@ def test_slows_near_obstacles_as_the_parameters_say():
     assert command.v == pytest.approx(0.5)
 
 
+def test_slows_for_the_walls_of_an_occupancy_grid_map():
+    # The simple maps manager writes a SimpleMap (boolean cells) in `map`: its walls slow the
+    # robot as a costmap's lethal cells do (before, they were no obstacles at all).
+    from test_map_as_costmap import OccupancyCells
+
+    cells = np.zeros((50, 60), dtype=bool)
+    cells[25, 12] = True  # the cell [0.2, 0.3) x [0.0, 0.1)
+    nav_state = NavState()
+    nav_state.set("map", OccupancyCells(cells, resolution=0.1, origin_x=-1.0, origin_y=-2.5))
+    controller = make_controller({"use_obstacle_regulated_linear_velocity_scaling": True,
+                                  "obstacle_scaling_dist": 0.6})
+    run_closed_loop(controller, straight_path(3.0), (0.0, 0.0, 0.0), steps=1,
+                    nav_state=nav_state)
+    radius = controller.get_robot_geometry().radius
+    clearance = controller.last_command.regulations["clearance"]
+    assert clearance == pytest.approx(math.hypot(0.25, 0.05) - radius)
+
+
 def test_rotates_to_heading_with_hysteresis():
     controller = make_controller()
     path = straight_path(3.0)

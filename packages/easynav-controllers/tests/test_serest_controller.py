@@ -109,6 +109,80 @@ def test_slows_for_an_obstacle_in_the_costmap_and_brakes_in_an_emergency():
     assert nav_state.get("serest.debug.d_closest") < 0.4
 
 
+def test_only_cells_in_the_way_count_when_headings_are_given():
+    costmap = Costmap2D.filled(80, 80, 0.05, -2.0, -2.0)
+    for x, y in ((1.01, 0.11), (0.01, 0.51), (-0.59, 0.01)):  # ahead, beside, behind
+        ix, iy = costmap.world_to_cell(x, y)
+        costmap.data[iy, ix] = LETHAL_OBSTACLE
+    ahead = math.hypot(1.025, 0.125) - 0.025
+    beside = math.hypot(0.025, 0.525) - 0.025
+    behind = math.hypot(0.575, 0.025) - 0.025
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5) == pytest.approx(beside)
+    # A 0.3 m strip along +x holds the cell ahead only; along -x, the one behind.
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (0.0,), 0.3) == pytest.approx(ahead)
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (math.pi,), 0.3) == pytest.approx(
+        behind
+    )
+    # Towards +y the cell beside is in the way; a strip too narrow for the others.
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (math.pi / 2,), 0.05) == pytest.approx(
+        beside
+    )
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (-math.pi / 2,), 0.3) == math.inf
+
+
+def test_drives_past_an_obstacle_beside_the_path_within_d0_margin():
+    # A wall 0.35 m beside a straight path (cells centred 0.375 m off it), d0_margin 0.4 m: the
+    # original's direction-free distance gave a safe speed of 0 from the start, for ever. The
+    # wall is outside the strip the robot (radius 0.3 m) sweeps, so it does not slow it.
+    clock = Clock()
+    serest = make({"d0_margin": 0.4}, LIMITS, clock)
+    path = straight_path()
+    nav_state = loop_state(path)
+    nav_state.set("goal_tolerance.position", 0.08)
+    nav_state.set("goal_tolerance.yaw", 0.05)
+    costmap = nav_state.get("map")
+    for x in np.arange(-0.5, 3.5, 0.05):
+        ix, iy = costmap.world_to_cell(x, 0.375)
+        costmap.data[iy, ix] = LETHAL_OBSTACLE
+    run = run_closed_loop(serest, nav_state, clock, dt=DT, t_max=30.0)
+    assert run.arrived
+    assert max(v for v, _ in run.commands) > 0.45
+
+
+def test_reversing_counts_the_obstacles_behind():
+    clock = Clock()
+    serest = make({"allow_reverse": True}, LIMITS, clock)
+    # The path runs backwards (-x) from the robot, which faces +x.
+    xs = np.arange(0.0, -3.001, -0.05)
+    nav_state = loop_state(np.column_stack((xs, np.zeros_like(xs), np.zeros_like(xs))))
+    costmap = nav_state.get("map")
+    for x in (1.01, -1.99):  # ahead of the robot (behind its way), behind it (in its way)
+        ix, iy = costmap.world_to_cell(x, 0.01)
+        costmap.data[iy, ix] = LETHAL_OBSTACLE
+    ahead, behind = (math.hypot(x, 0.025) - 0.025 for x in (1.025, 1.975))
+    set_pose(nav_state, 0.0, 0.0, 0.0)
+    serest.update_rt(nav_state)  # takes the path
+    serest.tracker.last_v = 0.0  # standing: the path's direction decides
+    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(behind)
+    serest.tracker.last_v = 0.2  # moving forward all the same: what is ahead counts
+    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(ahead)
+    serest.tracker.last_v = -0.2
+    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(behind)
+
+
+def test_the_walls_of_an_occupancy_grid_map_are_obstacles():
+    # The simple maps manager writes a SimpleMap (boolean cells) in `map`, not a Costmap2D.
+    from test_map_as_costmap import OccupancyCells
+
+    serest = make({}, LIMITS, Clock())
+    cells = np.zeros((50, 60), dtype=bool)
+    cells[25, 20] = True  # the cell [1.0, 1.1) x [0.0, 0.1)
+    nav_state = NavState()
+    nav_state.set("map", OccupancyCells(cells, resolution=0.1, origin_x=-1.0, origin_y=-2.5))
+    near = math.hypot(1.05, 0.05) - 0.05
+    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(near)
+
+
 def test_closest_obstacle_distance_key_overrides_the_map():
     clock = Clock()
     serest = make({}, LIMITS, clock)
@@ -183,12 +257,13 @@ def test_point_perceptions_count_only_when_a_points_group_exists():
     set_path(nav_state, straight_path())
     set_pose(nav_state, 0.0, 0.0, 0.0)
     nav_state.set("map", "a map of any other type")  # required, but not a Costmap2D
-    scan = np.array([[0.8, 0.6, 0.2], [3.0, 0.0, 0.2]])
+    # Ahead, beside (nearer, but not in the way of a 0.3 m robot driving on), out of range.
+    scan = np.array([[0.8, 0.2, 0.2], [0.1, 0.6, 0.2], [3.0, 0.0, 0.2]])
     nav_state.set("scan", PointPerception(scan, "base_footprint", clock.t))
     serest.update_rt(nav_state)
     assert nav_state.get("serest.debug.d_closest") == math.inf
     nav_state.set_group("points", ["a_grouped_sensor"])
     clock.t += DT
     serest.update_rt(nav_state)
-    # 0.3 m voxels: the point (0.8, 0.6) stays the first of its voxel; (3, 0) is out of range.
-    assert nav_state.get("serest.debug.d_closest") == pytest.approx(1.0)
+    # 0.3 m voxels: the point (0.8, 0.2) stays the first of its voxel.
+    assert nav_state.get("serest.debug.d_closest") == pytest.approx(math.hypot(0.8, 0.2))

@@ -12,7 +12,8 @@ from easynav.core.nav_state_keys import NavStateKey
 MAP = NavStateKey(
     "map",
     "Costmap2D",
-    "the dynamic costmap (costmap maps manager); absent: no obstacle terms.",
+    "the dynamic costmap (costmap maps manager), or the simple maps manager's SimpleMap (its "
+    "occupied cells are lethal); absent or of another kind: no obstacle terms.",
 )
 
 GOAL_TOLERANCE_POSITION = NavStateKey(

@@ -9,10 +9,23 @@ import numpy as np
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D
 
 
-def closest_lethal_distance(costmap: Costmap2D, x: float, y: float, radius: float) -> float:
+def closest_lethal_distance(
+    costmap: Costmap2D,
+    x: float,
+    y: float,
+    radius: float,
+    headings: tuple[float, ...] = (),
+    half_width: float = 0.0,
+) -> float:
     """Distance (m) from ``(x, y)`` to the nearest lethal cell within the square of half-side
     ``radius`` around it; ``inf`` when there is none. The distance is to the cell's nearest
     point (its centre minus half a cell), never below 0.
+
+    With ``headings`` (rad), only the cells in the way count: ahead of ``(x, y)`` along one of
+    the headings and within ``half_width`` of that line (the strip a disc of that radius sweeps
+    driving straight on; a cell counts when its centre is within half a cell of the strip). A
+    cell beside or behind the robot is not approached by driving on, and counting it stopped a
+    robot for good beside a pillar it would have passed.
 
     Only ``LETHAL_OBSTACLE`` cells count: inflated cells (253 and below) are cost, not
     obstacles. Pure function; any thread.
@@ -31,5 +44,30 @@ def closest_lethal_distance(costmap: Costmap2D, x: float, y: float, radius: floa
     if rows.size == 0:
         return math.inf
     cx, cy = costmap.cell_to_world(cols + ix0, rows + iy0)
-    d = np.hypot(cx - x, cy - y) - 0.5 * costmap.resolution
-    return max(float(d.min()), 0.0)
+    half_cell = 0.5 * costmap.resolution
+    d = nearest_distance(cx - x, cy - y, headings, half_width, slack=half_cell) - half_cell
+    return max(d, 0.0)
+
+
+def nearest_distance(
+    dx: np.ndarray,
+    dy: np.ndarray,
+    headings: tuple[float, ...] = (),
+    half_width: float = 0.0,
+    slack: float = 0.0,
+) -> float:
+    """The smallest ``hypot(dx, dy)`` of the offsets ``(dx, dy)`` from the robot (m); ``inf``
+    for none. With ``headings``, only the offsets in the way count: ahead along one of the
+    headings (by more than ``-slack``) and within ``half_width + slack`` of that line."""
+    dx, dy = np.asarray(dx, dtype=float), np.asarray(dy, dtype=float)
+    if headings:
+        in_the_way = np.zeros(dx.shape, dtype=bool)
+        for heading in headings:
+            ux, uy = math.cos(heading), math.sin(heading)
+            along = dx * ux + dy * uy
+            across = np.abs(dy * ux - dx * uy)
+            in_the_way |= (along > -slack) & (across < half_width + slack)
+        dx, dy = dx[in_the_way], dy[in_the_way]
+    if dx.size == 0:
+        return math.inf
+    return float(np.hypot(dx, dy).min())

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from easynav.common.sensors import PointPerception, PointPerceptionsOps
 from easynav.common.tf import get_tf_buffer
 from easynav.controllers.controller_keys import (
@@ -13,13 +15,17 @@ from easynav.controllers.controller_keys import (
     MAP,
     SEREST_DEBUG_KEYS,
 )
-from easynav.controllers.obstacle_distance import closest_lethal_distance
+from easynav.controllers.map_as_costmap import MapAsCostmap
+from easynav.controllers.obstacle_distance import closest_lethal_distance, nearest_distance
 from easynav.controllers.serest_tracker import SerestTracker
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, PATH, ROBOT_POSE
 from easynav.core.plugins import ControllerMethodBase, Param
 from easynav.core.robot import RobotLimits
-from easynav.core.types import Costmap2D, Header, Odometry, Path, Twist, TwistStamped
+from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
+
+#: Below this speed (m/s) the robot counts as standing: it may drive off either way.
+STANDSTILL = 0.01
 
 _GE0 = {"ge": 0.0}
 _GT0 = {"gt": 0.0}
@@ -50,7 +56,11 @@ class SerestController(ControllerMethodBase):
     nearest lethal cell of the Costmap2D in ``map`` within ``dist_search_radius``; else, when a
     NavState group named ``points`` exists (as the original), the nearest ungrouped point
     perception within the square of ``dist_search_radius`` (0.3 m voxels, z <= 2 m, robot
-    footprint frame); else none (infinite).
+    footprint frame); else none (infinite). Cells and points count only when they are in the
+    way: ahead in the direction of travel (both ways from a standstill with ``allow_reverse``),
+    within robot_geometry's ``radius`` of the line driven straight on. The original counted
+    every direction, so a robot that came within ``d0_margin`` of an obstacle beside it stopped
+    for good.
 
     NavState: reads ``path``, ``robot_pose``, ``map`` (required, as in the original: absent, the
     command is zero), ``closest_obstacle_distance``, ``goal_tolerance.position|yaw`` (preferred
@@ -124,6 +134,7 @@ class SerestController(ControllerMethodBase):
         self._last_time: float | None = None
         self._path: Path | None = None
         self._path_xy_yaw = None
+        self._map_as_costmap = MapAsCostmap()
 
     def on_initialize(self) -> None:
         self.tracker = SerestTracker(self.params)
@@ -135,16 +146,39 @@ class SerestController(ControllerMethodBase):
         """The limits in force (``get_robot_limits()``), read every cycle."""
         return self.get_robot_limits()
 
-    def obstacle_distance(self, nav_state: NavState, x: float, y: float) -> float:
+    def travel_headings(self, x: float, y: float, yaw: float) -> tuple[float, ...]:
+        """The heading the robot drives along next: its yaw when moving forward, the opposite
+        when reversing; from a standstill, the opposite only with ``allow_reverse`` when the
+        path near the robot runs backwards (as the tracker then reverses)."""
+        last_v = self.tracker.last_v
+        if last_v > STANDSTILL:
+            return (yaw,)
+        backwards = last_v < -STANDSTILL or (
+            self.params.allow_reverse and self._path_runs_backwards(x, y, yaw)
+        )
+        return (yaw + math.pi,) if backwards else (yaw,)
+
+    def _path_runs_backwards(self, x: float, y: float, yaw: float) -> bool:
+        xy = self._path_xy_yaw
+        if xy is None or len(xy) < 2:
+            return False
+        i = int(np.argmin(np.hypot(xy[:, 0] - x, xy[:, 1] - y)))
+        a, b = (i, i + 1) if i + 1 < len(xy) else (i - 1, i)
+        seg = math.atan2(xy[b, 1] - xy[a, 1], xy[b, 0] - xy[a, 0])
+        return math.cos(yaw - seg) < 0.0
+
+    def obstacle_distance(self, nav_state: NavState, x: float, y: float, yaw: float) -> float:
         """The closest obstacle's distance (see the class docstring for the sources)."""
         if nav_state.has(CLOSEST_OBSTACLE_DISTANCE):
             value = nav_state.get(CLOSEST_OBSTACLE_DISTANCE)
             if isinstance(value, (int, float)) and not math.isnan(value):
                 return float(value)
         radius = self.params.dist_search_radius
-        costmap = nav_state.get(MAP)
-        if isinstance(costmap, Costmap2D):
-            return closest_lethal_distance(costmap, x, y, radius)
+        half_width = self.get_robot_geometry().radius
+        headings = self.travel_headings(x, y, yaw)
+        costmap = self._map_as_costmap(nav_state.get(MAP))
+        if costmap is not None:
+            return closest_lethal_distance(costmap, x, y, radius, headings, half_width)
         if "points" not in nav_state.groups():
             return math.inf
         frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
@@ -156,9 +190,9 @@ class SerestController(ControllerMethodBase):
             .downsample(0.3)
             .as_points()
         )
-        if len(points) == 0:
-            return math.inf
-        return float(min(math.hypot(px, py) for px, py in points[:, :2]))
+        # The points are in the robot's frame: the robot at the origin, heading 0.
+        relative = tuple(heading - yaw for heading in headings)
+        return nearest_distance(points[:, 0], points[:, 1], relative, half_width)
 
     def _stop(self, nav_state: NavState, now: float, state: str) -> None:
         self.tracker.reset()
@@ -195,7 +229,7 @@ class SerestController(ControllerMethodBase):
             pose,
             dt,
             self.limits(),
-            self.obstacle_distance(nav_state, pose[0], pose[1]),
+            self.obstacle_distance(nav_state, *pose),
             None if pos_tol is None else float(pos_tol),
             None if yaw_tol is None else float(yaw_tol),
         )

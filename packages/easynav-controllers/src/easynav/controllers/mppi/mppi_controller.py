@@ -7,6 +7,7 @@ from typing import Any
 from easynav.common.tf import get_tf_buffer
 from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW, MAP
 from easynav.controllers.legacy_limits import capped_limits, warn_set_caps
+from easynav.controllers.map_as_costmap import MapAsCostmap
 from easynav.controllers.mppi.mppi_optimizer import (
     MPPI_LIMIT_CAPS,
     MPPI_PARAMETERS,
@@ -19,7 +20,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, NAVIGATION_STATE, PATH, ROBOT_POSE
 from easynav.core.plugins import ControllerMethodBase, PluginConfigurationError
 from easynav.core.robot import RobotLimits
-from easynav.core.types import Costmap2D, Header, Odometry, Path, Twist, TwistStamped
+from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
 
 
 class MPPIController(ControllerMethodBase):
@@ -34,9 +35,9 @@ class MPPIController(ControllerMethodBase):
 
     NavState: reads ``navigation_state`` ("IDLE": zero command), ``path``, ``robot_pose``,
     ``goal_tolerance.position`` / ``goal_tolerance.yaw`` (else ``xy_goal_tolerance`` /
-    ``yaw_goal_tolerance``), ``map`` (Costmap2D for the CostCritic and PathAlignCritic; absent:
-    no obstacle terms); writes ``cmd_vel`` (a new stamp every cycle; zero without path or pose,
-    at the goal and when idle).
+    ``yaw_goal_tolerance``), ``map`` (Costmap2D for the CostCritic and PathAlignCritic, or a
+    SimpleMap read through :class:`MapAsCostmap`; absent: no obstacle terms); writes
+    ``cmd_vel`` (a new stamp every cycle; zero without path or pose, at the goal and when idle).
 
     Thread contract: ``initialize`` in the configuring thread, ``update_rt`` in the RT thread.
     Exceptions: :class:`PluginConfigurationError` naming the parameter at configure time.
@@ -53,6 +54,7 @@ class MPPIController(ControllerMethodBase):
         self.last_command = MppiCommand()
         self._last_time: float | None = None
         self._path: Path | None = None
+        self._map_as_costmap = MapAsCostmap()
         self._path_xy_yaw = None
 
     def on_initialize(self) -> None:
@@ -110,7 +112,7 @@ class MPPIController(ControllerMethodBase):
         self._last_time = now
         if path is not self._path:  # the planner stores a new Path for each plan
             self._path, self._path_xy_yaw = path, path.as_xy_yaw()
-        costmap = nav_state.get_or(MAP, None)
+        costmap = self._map_as_costmap(nav_state.get_or(MAP, None))
         command = optimizer.compute(
             (robot.pose.x, robot.pose.y, robot.pose.yaw),
             self._path_xy_yaw,
@@ -118,7 +120,7 @@ class MPPIController(ControllerMethodBase):
             self.limits(),
             float(nav_state.get_or(GOAL_TOLERANCE_POSITION, self.params.xy_goal_tolerance)),
             float(nav_state.get_or(GOAL_TOLERANCE_YAW, self.params.yaw_goal_tolerance)),
-            costmap if isinstance(costmap, Costmap2D) else None,
+            costmap,
             path_key=path,
             robot_radius=self.get_robot_geometry().radius,
         )

@@ -7,6 +7,7 @@ import math
 from easynav.common.tf import get_tf_buffer
 from easynav.controllers.controller_keys import GOAL_TOLERANCE_POSITION, GOAL_TOLERANCE_YAW, MAP
 from easynav.controllers.legacy_limits import capped_limits, warn_set_caps
+from easynav.controllers.map_as_costmap import MapAsCostmap
 from easynav.controllers.regulated_pp.regulated_pure_pursuit import (
     NO_PATH,
     ROTATING_TO_GOAL,
@@ -20,7 +21,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, NAVIGATION_STATE, PATH, ROBOT_POSE
 from easynav.core.plugins import ControllerMethodBase, Topic
 from easynav.core.robot import RobotLimits
-from easynav.core.types import Costmap2D, Header, Odometry, Path, Twist, TwistStamped
+from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
 
 #: Seconds assumed since the previous cycle on the first one or after a pause (the original's).
 DEFAULT_DT = 0.05
@@ -37,9 +38,10 @@ class RegulatedPurePursuitController(ControllerMethodBase):
 
     NavState: reads ``navigation_state`` ("IDLE": zero command), ``path``, ``robot_pose``,
     ``goal_tolerance.position`` / ``goal_tolerance.yaw`` (else ``xy_goal_tolerance`` /
-    ``yaw_goal_tolerance``), ``map`` (Costmap2D, for obstacle regulation; absent: no obstacle
-    regulation); writes ``cmd_vel`` (a new stamp every cycle, zero without path or pose, at the
-    goal and when idle). Topics (relative, published only when subscribed): ``lookahead_point``,
+    ``yaw_goal_tolerance``), ``map`` (Costmap2D, or a SimpleMap read through
+    :class:`MapAsCostmap`, for obstacle regulation; absent: no obstacle regulation); writes
+    ``cmd_vel`` (a new stamp every cycle, zero without path or pose, at the goal and when
+    idle). Topics (relative, published only when subscribed): ``lookahead_point``,
     ``curvature_lookahead_point`` (PointStamped, z = 0.05), ``is_rotating_to_heading`` (Bool).
 
     Thread contract: ``initialize`` in the configuring thread, ``update_rt`` in the RT thread.
@@ -64,6 +66,7 @@ class RegulatedPurePursuitController(ControllerMethodBase):
         self.state = NO_PATH
         self.last_command = RppCommand()
         self._last_time: float | None = None
+        self._map_as_costmap = MapAsCostmap()
         self._publishers: dict[str, object] = {}
         self._path: Path | None = None
         self._path_xy_yaw = None
@@ -121,9 +124,7 @@ class RegulatedPurePursuitController(ControllerMethodBase):
         if dt <= 0.0 or dt > 1.0:
             dt = DEFAULT_DT
         self._last_time = now
-        costmap = nav_state.get_or(MAP, None)
-        if not isinstance(costmap, Costmap2D):
-            costmap = None
+        costmap = self._map_as_costmap(nav_state.get_or(MAP, None))
         command = self.algorithm.compute(
             (robot.pose.x, robot.pose.y, robot.pose.yaw),
             self._xy_yaw(path),

@@ -1,0 +1,46 @@
+"""MapAsCostmap: the NavState ``map`` as a Costmap2D for the controllers' obstacle terms."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from easynav.core.types import FREE_SPACE, LETHAL_OBSTACLE, Costmap2D
+
+
+class MapAsCostmap:
+    """Reads NavState ``map`` as a :class:`Costmap2D`, whatever the maps manager wrote there.
+
+    A Costmap2D is returned as it is. A boolean occupancy grid (``cells``, ``(height, width)``,
+    with ``resolution``, ``origin_x``, ``origin_y``: the simple maps manager's SimpleMap) becomes
+    a costmap of lethal and free cells, converted once per map object (the maps managers write a
+    new one on every update and never change one in place). Anything else is None: no obstacle
+    terms. Before, a controller over the simple maps manager saw no obstacles at all, and MPPI
+    drove into a pillar of the TurtleBot3 sandbox that its map held.
+
+    Thread contract: one instance per controller, called from its RT thread.
+    """
+
+    def __init__(self) -> None:
+        self._source: object = None
+        self._costmap: Costmap2D | None = None
+
+    def __call__(self, value: object) -> Costmap2D | None:
+        if isinstance(value, Costmap2D):
+            return value
+        if value is self._source:
+            return self._costmap
+        self._source, self._costmap = value, _grid_as_costmap(value)
+        return self._costmap
+
+
+def _grid_as_costmap(value: object) -> Costmap2D | None:
+    cells = getattr(value, "cells", None)
+    if not isinstance(cells, np.ndarray) or cells.dtype != bool or cells.ndim != 2:
+        return None
+    try:
+        resolution = float(value.resolution)
+        origin_x, origin_y = float(value.origin_x), float(value.origin_y)
+    except (AttributeError, TypeError, ValueError):
+        return None
+    data = np.where(cells, np.uint8(LETHAL_OBSTACLE), np.uint8(FREE_SPACE))
+    return Costmap2D(data=data, resolution=resolution, origin_x=origin_x, origin_y=origin_y)
