@@ -20,7 +20,7 @@ from closed_loop import (
 )
 
 from easynav.common.sensors import PointPerception
-from easynav.controllers.obstacle_distance import closest_lethal_distance
+from easynav.controllers.obstacle_distance import RobotWay, closest_lethal_distance
 from easynav.controllers.serest_controller import SerestController
 from easynav.controllers.serest_tracker import SEREST_DEFAULTS, SerestTracker
 from easynav.core.nav_state import NavState
@@ -109,7 +109,7 @@ def test_slows_for_an_obstacle_in_the_costmap_and_brakes_in_an_emergency():
     assert nav_state.get("serest.debug.d_closest") < 0.4
 
 
-def test_only_cells_in_the_way_count_when_headings_are_given():
+def test_only_cells_in_the_way_count():
     costmap = Costmap2D.filled(80, 80, 0.05, -2.0, -2.0)
     for x, y in ((1.01, 0.11), (0.01, 0.51), (-0.59, 0.01)):  # ahead, beside, behind
         ix, iy = costmap.world_to_cell(x, y)
@@ -118,16 +118,24 @@ def test_only_cells_in_the_way_count_when_headings_are_given():
     beside = math.hypot(0.025, 0.525) - 0.025
     behind = math.hypot(0.575, 0.025) - 0.025
     assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5) == pytest.approx(beside)
-    # A 0.3 m strip along +x holds the cell ahead only; along -x, the one behind.
-    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (0.0,), 0.3) == pytest.approx(ahead)
-    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (math.pi,), 0.3) == pytest.approx(
-        behind
+    # Driving straight on along +x with a 0.3 m radius: the cell ahead only; along -x, the
+    # one behind; along -y, none.
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, RobotWay(0.0, half_width=0.3)) == (
+        pytest.approx(ahead)
     )
-    # Towards +y the cell beside is in the way; a strip too narrow for the others.
-    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (math.pi / 2,), 0.05) == pytest.approx(
-        beside
-    )
-    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, (-math.pi / 2,), 0.3) == math.inf
+    backwards = RobotWay(math.pi, half_width=0.3)
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, backwards) == pytest.approx(behind)
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, RobotWay(-math.pi / 2, 0.0, None, 0.3)
+                                   ) == math.inf
+    # Turning left on a 0.2625 m radius, the robot passes over the cell beside it (the arc's
+    # top is at (0, 0.525)); turning right it does not (the cell ahead is still in its way
+    # straight on); a path ahead leading to it counts it too.
+    left = RobotWay(0.0, curvature=1 / 0.2625, half_width=0.1)
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, left) == pytest.approx(beside)
+    right = RobotWay(0.0, curvature=-1 / 0.2625, half_width=0.1)
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, right) == pytest.approx(ahead)
+    to_it = RobotWay(-math.pi / 2, 0.0, np.array([[0.0, 0.0], [0.0, 0.8]]), 0.1)
+    assert closest_lethal_distance(costmap, 0.0, 0.0, 1.5, to_it) == pytest.approx(beside)
 
 
 def test_drives_past_an_obstacle_beside_the_path_within_d0_margin():
@@ -149,25 +157,50 @@ def test_drives_past_an_obstacle_beside_the_path_within_d0_margin():
     assert max(v for v, _ in run.commands) > 0.45
 
 
-def test_reversing_counts_the_obstacles_behind():
+def bend_path(radius: float = 0.8) -> np.ndarray:
+    """1 m straight along +x, then a left half turn of ``radius``."""
+    straight = np.column_stack((np.arange(0.0, 1.0, 0.05), np.zeros(20)))
+    a = np.arange(0.0, math.pi, 0.05 / radius)
+    arc = np.column_stack((1.0 + radius * np.sin(a), radius * (1.0 - np.cos(a))))
+    xy = np.vstack((straight, arc))
+    return np.column_stack((xy, np.arctan2(np.gradient(xy[:, 1]), np.gradient(xy[:, 0]))))
+
+
+def test_stops_short_of_an_obstacle_on_a_bend_of_the_path():
+    # A cell 0.15 m outside the bend, 1 m along the arc: off the straight line ahead of the
+    # robot until it is near, in its way as it follows the path. At 1 m/s, counting only the
+    # straight line ahead, the robot saw it 0.4 m off with 0.8 m needed to stop, and ran
+    # 11 cm into it. It stops d0_margin (0.3 m) short of it.
     clock = Clock()
-    serest = make({"allow_reverse": True}, LIMITS, clock)
-    # The path runs backwards (-x) from the robot, which faces +x.
-    xs = np.arange(0.0, -3.001, -0.05)
-    nav_state = loop_state(np.column_stack((xs, np.zeros_like(xs), np.zeros_like(xs))))
+    limits = RobotLimits(max_linear_vel=1.0, max_angular_vel=1.5, max_linear_acc=1.0)
+    serest = make({"v_ref": 1.0}, limits, clock)
+    nav_state = loop_state(bend_path())
     costmap = nav_state.get("map")
-    for x in (1.01, -1.99):  # ahead of the robot (behind its way), behind it (in its way)
-        ix, iy = costmap.world_to_cell(x, 0.01)
-        costmap.data[iy, ix] = LETHAL_OBSTACLE
-    ahead, behind = (math.hypot(x, 0.025) - 0.025 for x in (1.025, 1.975))
-    set_pose(nav_state, 0.0, 0.0, 0.0)
-    serest.update_rt(nav_state)  # takes the path
-    serest.tracker.last_v = 0.0  # standing: the path's direction decides
-    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(behind)
-    serest.tracker.last_v = 0.2  # moving forward all the same: what is ahead counts
-    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(ahead)
-    serest.tracker.last_v = -0.2
-    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(behind)
+    a = 1.0 / 0.8
+    ix, iy = costmap.world_to_cell(1.0 + 0.95 * math.sin(a), 0.8 - 0.95 * math.cos(a))
+    costmap.data[iy, ix] = LETHAL_OBSTACLE
+    cx, cy = costmap.cell_to_world(ix, iy)
+    run = run_closed_loop(serest, nav_state, clock, dt=DT, t_max=15.0)
+    nearest = min(math.hypot(x - cx, y - cy) for x, y, _ in run.poses) - 0.025
+    assert nearest > SEREST_DEFAULTS["d0_margin"] - 0.01
+    assert max(v for v, _ in run.commands) > 0.9  # at full speed on the straight
+
+
+def test_point_perceptions_are_turned_into_the_map_frame():
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    nav_state = NavState()
+    # The robot faces +y; the path runs along +y.
+    set_path(nav_state, np.column_stack((np.zeros(41), np.arange(0.0, 2.01, 0.05),
+                                         np.full(41, math.pi / 2))))
+    set_pose(nav_state, 0.0, 0.0, math.pi / 2)
+    nav_state.set("map", "a map of any other type")
+    nav_state.set_group("points", ["a_grouped_sensor"])
+    # In the robot's frame: ahead (x = 0.8), and on its right (y = -0.6), not in its way.
+    scan = np.array([[0.8, 0.05, 0.2], [0.0, -0.6, 0.2]])
+    nav_state.set("scan", PointPerception(scan, "base_footprint", clock.t))
+    serest.update_rt(nav_state)
+    assert nav_state.get("serest.debug.d_closest") == pytest.approx(math.hypot(0.8, 0.05))
 
 
 def test_the_walls_of_an_occupancy_grid_map_are_obstacles():

@@ -13,7 +13,7 @@ MAP = NavStateKey(
     "map",
     "Costmap2D",
     "the dynamic costmap (costmap maps manager), or the simple maps manager's SimpleMap (its "
-    "occupied cells are lethal); absent or of another kind: no obstacle terms.",
+    "occupied cells are lethal obstacles).",
 )
 
 GOAL_TOLERANCE_POSITION = NavStateKey(

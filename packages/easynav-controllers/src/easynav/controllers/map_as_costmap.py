@@ -14,8 +14,8 @@ class MapAsCostmap:
     with ``resolution``, ``origin_x``, ``origin_y``: the simple maps manager's SimpleMap) becomes
     a costmap of lethal and free cells, converted once per map object (the maps managers write a
     new one on every update and never change one in place). Anything else is None: no obstacle
-    terms. Before, a controller over the simple maps manager saw no obstacles at all, and MPPI
-    drove into a pillar of the TurtleBot3 sandbox that its map held.
+    terms. The conversion has no inflation: the cost-graded terms (MPPI's CostCritic) see lethal
+    and free cells only.
 
     Thread contract: one instance per controller, called from its RT thread.
     """

@@ -16,7 +16,11 @@ from easynav.controllers.controller_keys import (
     SEREST_DEBUG_KEYS,
 )
 from easynav.controllers.map_as_costmap import MapAsCostmap
-from easynav.controllers.obstacle_distance import closest_lethal_distance, nearest_distance
+from easynav.controllers.obstacle_distance import (
+    RobotWay,
+    closest_lethal_distance,
+    nearest_distance,
+)
 from easynav.controllers.serest_tracker import SerestTracker
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, PATH, ROBOT_POSE
@@ -24,8 +28,11 @@ from easynav.core.plugins import ControllerMethodBase, Param
 from easynav.core.robot import RobotLimits
 from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
 
-#: Below this speed (m/s) the robot counts as standing: it may drive off either way.
+#: Below this speed (m/s) the robot counts as standing: its last command has no curvature.
 STANDSTILL = 0.01
+
+#: Voxel size (m) of the point perceptions' downsampling, as the original's.
+POINTS_VOXEL = 0.3
 
 _GE0 = {"ge": 0.0}
 _GT0 = {"gt": 0.0}
@@ -52,15 +59,16 @@ class SerestController(ControllerMethodBase):
     ``max_linear_acc``, ``max_angular_acc`` are deprecated: unset by default; set, controller_node
     applies each to its robot_limits field where the params file does not set that field.
 
-    Obstacle distance: NavState ``closest_obstacle_distance`` (float) when present; else the
-    nearest lethal cell of the Costmap2D in ``map`` within ``dist_search_radius``; else, when a
-    NavState group named ``points`` exists (as the original), the nearest ungrouped point
-    perception within the square of ``dist_search_radius`` (0.3 m voxels, z <= 2 m, robot
-    footprint frame); else none (infinite). Cells and points count only when they are in the
-    way: ahead in the direction of travel (both ways from a standstill with ``allow_reverse``),
-    within robot_geometry's ``radius`` of the line driven straight on. The original counted
-    every direction, so a robot that came within ``d0_margin`` of an obstacle beside it stopped
-    for good.
+    Obstacle distance: NavState ``closest_obstacle_distance`` (float) when present, taken as
+    it is; else the nearest lethal cell of the map in ``map`` (a Costmap2D, or a SimpleMap's
+    occupied cells: :class:`MapAsCostmap`) within ``dist_search_radius``; else, when a NavState
+    group named ``points`` exists (as the original), the nearest ungrouped point perception
+    within the square of ``dist_search_radius`` (0.3 m voxels, z <= 2 m, robot footprint
+    frame); else none (infinite). Cells and points count only when they are in the robot's way
+    (:class:`RobotWay`): within robot_geometry's ``radius`` of the line it drives on straight,
+    of the arc of its last command, or of the path ahead of it. The original counted every
+    direction, so a robot that came within ``d0_margin`` of an obstacle beside it stopped for
+    good.
 
     NavState: reads ``path``, ``robot_pose``, ``map`` (required, as in the original: absent, the
     command is zero), ``closest_obstacle_distance``, ``goal_tolerance.position|yaw`` (preferred
@@ -134,6 +142,7 @@ class SerestController(ControllerMethodBase):
         self._last_time: float | None = None
         self._path: Path | None = None
         self._path_xy_yaw = None
+        self._path_points: tuple[np.ndarray, np.ndarray] | None = None  # cleaned, arc lengths
         self._map_as_costmap = MapAsCostmap()
 
     def on_initialize(self) -> None:
@@ -146,26 +155,31 @@ class SerestController(ControllerMethodBase):
         """The limits in force (``get_robot_limits()``), read every cycle."""
         return self.get_robot_limits()
 
-    def travel_headings(self, x: float, y: float, yaw: float) -> tuple[float, ...]:
-        """The heading the robot drives along next: its yaw when moving forward, the opposite
-        when reversing; from a standstill, the opposite only with ``allow_reverse`` when the
-        path near the robot runs backwards (as the tracker then reverses)."""
-        last_v = self.tracker.last_v
-        if last_v > STANDSTILL:
-            return (yaw,)
-        backwards = last_v < -STANDSTILL or (
-            self.params.allow_reverse and self._path_runs_backwards(x, y, yaw)
-        )
-        return (yaw + math.pi,) if backwards else (yaw,)
+    def robot_way(self, x: float, y: float, yaw: float) -> RobotWay:
+        """Where the robot is going (see :class:`RobotWay`): its heading (backwards when
+        reversing), the curvature of its last command while moving, the path ahead of its
+        projection (as far as obstacles are searched), its radius."""
+        v, w = self.tracker.last_v, self.tracker.last_w
+        heading = yaw + math.pi if v < -STANDSTILL else yaw
+        curvature = w / abs(v) if abs(v) > STANDSTILL else 0.0  # turning on the spot: none
+        ahead = self._path_ahead(x, y)
+        return RobotWay(heading, curvature, ahead, self.get_robot_geometry().radius)
 
-    def _path_runs_backwards(self, x: float, y: float, yaw: float) -> bool:
-        xy = self._path_xy_yaw
-        if xy is None or len(xy) < 2:
-            return False
-        i = int(np.argmin(np.hypot(xy[:, 0] - x, xy[:, 1] - y)))
-        a, b = (i, i + 1) if i + 1 < len(xy) else (i - 1, i)
-        seg = math.atan2(xy[b, 1] - xy[a, 1], xy[b, 0] - xy[a, 0])
-        return math.cos(yaw - seg) < 0.0
+    def _path_ahead(self, x: float, y: float) -> np.ndarray | None:
+        if self._path_xy_yaw is None or len(self._path_xy_yaw) == 0:
+            return None
+        if self._path_points is None:
+            pts = SerestTracker._clean(self._path_xy_yaw, (x, y))
+            steps = np.hypot(*(np.diff(pts, axis=0).T))
+            self._path_points = (pts, np.concatenate(([0.0], np.cumsum(steps))))
+        pts, s_acc = self._path_points
+        here = np.array((x, y))
+        seg, closest, s_star = SerestTracker.project(pts, s_acc, here)
+        # Beyond the search square's corner no cell is searched.
+        reach = self.params.dist_search_radius * math.sqrt(2.0)
+        last = int(np.searchsorted(s_acc, s_star + reach, side="right"))
+        ahead = np.vstack((closest, pts[seg + 1 : max(last, seg + 1) + 1]))
+        return ahead - here
 
     def obstacle_distance(self, nav_state: NavState, x: float, y: float, yaw: float) -> float:
         """The closest obstacle's distance (see the class docstring for the sources)."""
@@ -174,25 +188,27 @@ class SerestController(ControllerMethodBase):
             if isinstance(value, (int, float)) and not math.isnan(value):
                 return float(value)
         radius = self.params.dist_search_radius
-        half_width = self.get_robot_geometry().radius
-        headings = self.travel_headings(x, y, yaw)
+        way = self.robot_way(x, y, yaw)
         costmap = self._map_as_costmap(nav_state.get(MAP))
         if costmap is not None:
-            return closest_lethal_distance(costmap, x, y, radius, headings, half_width)
+            return closest_lethal_distance(costmap, x, y, radius, way)
         if "points" not in nav_state.groups():
             return math.inf
         frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
         points = (
             PointPerceptionsOps(nav_state.get_no_group(PointPerception), logger=self.logger)
-            .downsample(0.3)
+            .downsample(POINTS_VOXEL)
             .fuse(frame)
             .filter((-radius, -radius, math.nan), (radius, radius, 2.0))
-            .downsample(0.3)
+            .downsample(POINTS_VOXEL)
             .as_points()
         )
-        # The points are in the robot's frame: the robot at the origin, heading 0.
-        relative = tuple(heading - yaw for heading in headings)
-        return nearest_distance(points[:, 0], points[:, 1], relative, half_width)
+        # The points are in the robot's frame: turned by its yaw, they are map-frame offsets.
+        c, s = math.cos(yaw), math.sin(yaw)
+        dx = c * points[:, 0] - s * points[:, 1]
+        dy = s * points[:, 0] + c * points[:, 1]
+        # A point stands for its voxel (the first point of it is kept): half its diagonal.
+        return nearest_distance(dx, dy, way, slack=POINTS_VOXEL * math.sqrt(0.5))
 
     def _stop(self, nav_state: NavState, now: float, state: str) -> None:
         self.tracker.reset()
@@ -221,6 +237,7 @@ class SerestController(ControllerMethodBase):
         self._last_time = now
         if path is not self._path:
             self._path, self._path_xy_yaw = path, path.as_xy_yaw()
+            self._path_points = None
         pose = (robot.pose.x, robot.pose.y, robot.pose.yaw)
         pos_tol = nav_state.get_or(GOAL_TOLERANCE_POSITION, None)
         yaw_tol = nav_state.get_or(GOAL_TOLERANCE_YAW, None)
