@@ -9,7 +9,6 @@ import pytest
 
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
-from easynav.core.robot import RobotGeometry
 from easynav.core.types import (
     Costmap2D,
     DiagnosticLevel,
@@ -29,7 +28,6 @@ from easynav.planners.costmap_planner import (
     smooth_path,
     without_cells_behind,
 )
-from easynav.planners.inscribed_band import with_inscribed_band
 
 _namespaces = itertools.count()
 
@@ -53,12 +51,11 @@ def room() -> Costmap2D:
     return Costmap2D(data, 0.05, 0.0, 0.0, "map", 4.5)
 
 
-def make_planner(params=None, geometry: RobotGeometry | None = None) -> CostmapPlanner:
+def make_planner(params=None) -> CostmapPlanner:
     context = PluginContext(
         parameters=DictParameters({f"costmap.{k}": v for k, v in (params or {}).items()}),
         namespace=f"costmap_planner_test_{next(_namespaces)}",
         now=lambda: 7.0,
-        robot_geometry=lambda: geometry or RobotGeometry(),
     )
     planner = CostmapPlanner()
     planner.initialize(context, "costmap")
@@ -346,57 +343,3 @@ def test_leaves_ahead_and_the_blocked_cells_agree():
     up = np.array([[10, 10], [10, 11], [11, 12], [12, 13], [13, 14], [14, 15], [15, 16]])
     right = np.array([[10, 10], [11, 10], [12, 11], [13, 11]])
     assert leaves_ahead(up, np.pi / 2, 6) and not leaves_ahead(right, np.pi / 2, 6)
-
-
-def wall_with_an_end() -> Costmap2D:
-    """8 x 4 m at 0.05 m, uninflated: walls around and one at x = 4 m from y = 0 to 2 m."""
-    data = np.zeros((80, 160), dtype=np.uint8)
-    data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 254
-    data[0:40, 80:82] = 254
-    return Costmap2D(data, 0.05, 0.0, 0.0, "map", 4.5)
-
-
-def clearance(path: Path, costmap: Costmap2D) -> float:
-    """The smallest distance from a path pose to a lethal cell's centre."""
-    wx, wy = costmap.cell_to_world(*np.nonzero(costmap.data.T == 254))
-    points = xy(path)
-    return float(np.min(np.hypot(points[:, :1] - wx, points[:, 1:2] - wy)))
-
-
-def test_a_set_robot_size_keeps_the_path_off_the_walls_of_an_uninflated_costmap():
-    # Round the end of a wall the costmap has no inflation for: the original's A* (costs below
-    # 253 are open) routes the robot's centre past the wall's end a cell away. With the robot's
-    # size set, its inscribed radius is kept clear.
-    costmap = wall_with_an_end()
-    bare = make_planner()
-    nav_state = state_with((5.0, 1.0, 0.0), robot_xy=(3.0, 1.0), costmap=costmap)
-    bare.update(nav_state)
-    assert clearance(nav_state.get("path", Path), costmap) < 0.1
-    sized = make_planner(geometry=RobotGeometry(radius=0.3, user_set=frozenset({"radius"})))
-    nav_state = state_with((5.0, 1.0, 0.0), robot_xy=(3.0, 1.0), costmap=costmap)
-    sized.update(nav_state)
-    assert clearance(nav_state.get("path", Path), costmap) > 0.3 - 0.05  # smoothing: a cell
-
-
-def test_a_robot_standing_in_the_band_can_leave_it():
-    costmap = wall_with_an_end()
-    sized = make_planner(geometry=RobotGeometry(radius=0.3, user_set=frozenset({"radius"})))
-    nav_state = state_with((5.0, 1.0, 0.0), robot_xy=(3.85, 1.0), costmap=costmap)  # 0.15 m off
-    sized.update(nav_state)
-    assert len(nav_state.get("path", Path)) > 0
-
-
-def test_the_band_of_an_inflated_costmap_is_already_there():
-    data = wall_with_an_end().data
-    inflated = Costmap2D(inflate(data, 0.05, 0.6, 0.3, 3.0), 0.05)
-    assert np.array_equal(with_inscribed_band(inflated, 0.3).data, inflated.data)
-    banded = with_inscribed_band(Costmap2D(data, 0.05), 0.3).data
-    yy, xx = np.mgrid[0:80, 0:160]
-    walls = np.argwhere(data == 254)
-    distance = np.full(data.shape, np.inf)
-    for wy, wx in walls:
-        distance = np.minimum(distance, np.hypot(yy - wy, xx - wx) * 0.05)
-    # Blocked (>= 253): the walls and the cells within 0.3 m of them, as the inflation
-    # filter's inscribed band (d * resolution <= radius, in floating point).
-    assert np.array_equal(banded == 254, data == 254)
-    assert np.array_equal(banded >= 253, distance <= 0.3)

@@ -17,7 +17,6 @@ from easynav.planners.costmap_astar import (
     compiled_available,
     path_cost,
 )
-from easynav.planners.inscribed_band import open_around, with_inscribed_band
 from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, PathPlannerBase
 
 __all__ = [
@@ -88,13 +87,6 @@ class CostmapPlanner(PathPlannerBase):
     (:mod:`easynav.planners.costmap_astar`). The cell path (start cell excluded, as in the
     original) is smoothed by a 5-point moving average (ends kept), ends exactly at the goal,
     and each pose faces the next one (the last one takes the goal's yaw).
-
-    The robot's size (beyond the original): when ``system_node.robot_geometry`` sets the
-    robot's radius, cells within its inscribed radius of a lethal cell count as inscribed
-    (253) too, except around the robot itself (so that it can leave the band it stands in). A
-    costmap inflated for the robot has that band already; on one left uninflated (a voxel
-    map's projection without an inflation filter) the original routed the robot's centre
-    along the walls, and the integration matrix saw the robot hit a wall's end.
 
     NavState: reads ``goals`` (plans to the first), ``robot_pose``, ``map`` (Costmap2D with the
     filters applied), ``map.base`` (to reject goals that can never be reached) and ``map_time``;
@@ -167,9 +159,6 @@ class CostmapPlanner(PathPlannerBase):
         self._last_cells: np.ndarray | None = None
         self._last_path: Path | None = None
         self._last_grid: tuple | None = None  # the costmap geometry _last_cells refer to
-        self._band_source: Costmap2D | None = None  # the costmap _band was computed from
-        self._band_radius = 0.0
-        self._band: Costmap2D | None = None
 
     def configure_planner(self) -> None:
         """Warn when A* cannot be compiled."""
@@ -198,25 +187,11 @@ class CostmapPlanner(PathPlannerBase):
         if not nav_state.has(MAP):
             self.fail(nav_state, map_frame, f"{goal_text}: no costmap yet (NavState '{MAP}')")
             return
-        costmap = self._with_robot_band(nav_state.get(MAP, Costmap2D), robot)
+        costmap = nav_state.get(MAP, Costmap2D)
         if not self.params.continuous_replan and self._can_keep(costmap, goal):
             self.write_path(nav_state, self._last_path, self._ok_message(goal_text))
             return
         self._plan(nav_state, costmap, robot, goal, goal_text, map_frame)
-
-    def _with_robot_band(self, source: Costmap2D, robot: Odometry) -> Costmap2D:
-        """``source`` with the robot's inscribed band (see the class docstring), opened around
-        the robot; the band is computed once per costmap."""
-        geometry = self.get_robot_geometry()
-        if not (geometry.is_set("inscribed_radius") or geometry.is_set("radius")):
-            return source
-        radius = geometry.inscribed_radius
-        if self._band_source is not source or self._band_radius != radius:
-            self._band_source, self._band_radius = source, radius
-            self._band = with_inscribed_band(source, radius)
-        if self._band is source:
-            return source
-        return open_around(self._band, source, robot.pose.x, robot.pose.y, radius)
 
     def _plan(self, nav_state, costmap, robot, goal, goal_text, map_frame) -> None:
         gx, gy, gyaw = goal
