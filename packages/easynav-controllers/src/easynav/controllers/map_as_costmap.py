@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import numpy as np
-
-from easynav.core.types import FREE_SPACE, LETHAL_OBSTACLE, Costmap2D
+from easynav.core.types import Costmap2D
 
 
 class MapAsCostmap:
@@ -29,18 +27,6 @@ class MapAsCostmap:
             return value
         if value is self._source:
             return self._costmap
-        self._source, self._costmap = value, _grid_as_costmap(value)
+        self._source, self._costmap = value, Costmap2D.from_occupancy_cells(value)
         return self._costmap
 
-
-def _grid_as_costmap(value: object) -> Costmap2D | None:
-    cells = getattr(value, "cells", None)
-    if not isinstance(cells, np.ndarray) or cells.dtype != bool or cells.ndim != 2:
-        return None
-    try:
-        resolution = float(value.resolution)
-        origin_x, origin_y = float(value.origin_x), float(value.origin_y)
-    except (AttributeError, TypeError, ValueError):
-        return None
-    data = np.where(cells, np.uint8(LETHAL_OBSTACLE), np.uint8(FREE_SPACE))
-    return Costmap2D(data=data, resolution=resolution, origin_x=origin_x, origin_y=origin_y)

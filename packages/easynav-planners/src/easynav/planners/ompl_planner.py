@@ -40,10 +40,9 @@ def as_costmap(world: Any) -> Costmap2D:
     """
     if isinstance(world, Costmap2D):
         return world
-    cells = getattr(world, "cells", None)
-    if isinstance(cells, np.ndarray) and cells.dtype == bool:
-        data = np.where(cells, LETHAL_OBSTACLE, 0).astype(np.uint8)
-        return Costmap2D(data, world.resolution, world.origin_x, world.origin_y)
+    costmap = Costmap2D.from_occupancy_cells(world)
+    if costmap is not None:
+        return costmap
     raise TypeError(f"NavState '{MAP}' holds a {type(world).__name__}, not a Costmap2D")
 
 

@@ -113,3 +113,22 @@ class Costmap2D:
             self.origin_x + self.width * self.resolution,
             self.origin_y + self.height * self.resolution,
         )
+
+    @classmethod
+    def from_occupancy_cells(cls, grid: object) -> Costmap2D | None:
+        """A boolean occupancy grid as a costmap: its occupied cells lethal, the others free.
+
+        ``grid`` has ``cells`` (bool, ``(height, width)``), ``resolution``, ``origin_x`` and
+        ``origin_y``, as the simple maps manager's SimpleMap (which the kernel does not import).
+        None for anything else. A new costmap of the grid's geometry; frame "map", stamp 0.
+        """
+        cells = getattr(grid, "cells", None)
+        if not isinstance(cells, np.ndarray) or cells.dtype != bool or cells.ndim != 2:
+            return None
+        try:
+            resolution = float(grid.resolution)
+            origin_x, origin_y = float(grid.origin_x), float(grid.origin_y)
+        except (AttributeError, TypeError, ValueError):
+            return None
+        data = np.where(cells, np.uint8(LETHAL_OBSTACLE), np.uint8(FREE_SPACE))
+        return cls(data, resolution, origin_x, origin_y)
