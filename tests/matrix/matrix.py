@@ -438,6 +438,8 @@ def compose_params(combo: Combination, sections: dict[str, dict] | None = None) 
             known = sections.get(plugin)
             if stack is not None:
                 params[alias] = copy.deepcopy(stack[plugin])
+                if known and _plans_on(combo.planner, plugin):
+                    _take_the_filters(params[alias], known["section"])
             else:
                 params[alias] = copy.deepcopy(known["section"]) if known else {"plugin": plugin}
     _add_the_sensors_they_read(document, combo, sections)
@@ -445,6 +447,30 @@ def compose_params(combo: Combination, sections: dict[str, dict] | None = None) 
     system = document.setdefault("system_node", {}).setdefault("ros__parameters", {})
     system.setdefault("safety", {}).setdefault("heartbeat", {})["period"] = 0.5
     return document
+
+
+def _plans_on(planner: str, maps_manager: str) -> bool:
+    """Whether ``planner`` works on a map representation that ``maps_manager`` provides."""
+    needs = needed_maps(plugin_class("planner", planner))
+    return bool(set(needs) & set(provided_maps(plugin_class("maps manager", maps_manager))))
+
+
+def _take_the_filters(section: dict, own: dict) -> None:
+    """A stack member's ``section`` that a row's planner plans on, with the filters of the
+    member's own representative ``own`` section where it has none. A stack's file tunes its
+    members for the planner it plans with: the NavMap stack's Bonxai walls project to a
+    costmap without an inflation filter, as its NavMap planner never reads that costmap. A row
+    that plans on that costmap (the CostmapPlanner, which like the original's and Nav2's
+    planners keeps off lethal and inflated cells only and knows nothing of the robot's size)
+    is configured as the file written for planning on it (Bonxai's own) configures it;
+    uninflated, the path ran along walls and the robot hit them (home and TurtleBot3 sandbox,
+    the NavMap stack's four CostmapPlanner rows)."""
+    if section.get("filters") or not own.get("filters"):
+        return
+    section["filters"] = list(own["filters"])
+    for name in own["filters"]:
+        if name in own:
+            section[name] = copy.deepcopy(own[name])
 
 
 #: The kind of robot sensor (:func:`world_sensors`) behind each sensor message type.

@@ -200,6 +200,22 @@ def test_two_maps_managers_side_by_side_only_where_a_plugin_needs_both():
     assert bonxai["insert_perceptions"] is False
 
 
+def test_a_stack_member_planned_on_gets_the_filters_of_its_own_file():
+    # The NavMap stack's file plans on the NavMap and leaves the Bonxai walls' costmap
+    # uninflated; a row planning on that costmap inflates it as Bonxai's own file does.
+    def bonxai_of(planner):
+        combo = next(c for c in combinations(("home",)) if len(c.maps_managers) == 2
+                     and c.planner == planner and "NavMap" in c.maps_manager)
+        maps = compose_params(combo)["maps_manager_node"]["ros__parameters"]
+        return next(maps[a] for a in maps["map_types"] if "Bonxai" in maps[a]["plugin"])
+
+    on_costmap = bonxai_of("easynav_costmap_planner/CostmapPlanner")
+    assert on_costmap["insert_perceptions"] is False  # still the stack's section
+    assert on_costmap["filters"] == ["inflation"]
+    assert on_costmap["inflation"]["plugin"].endswith("/InflationFilter")
+    assert not bonxai_of("easynav_navmap_planner/AStarPlanner").get("filters")
+
+
 def test_only_a_mission_stopped_from_outside_is_not_kept():
     from run_matrix import _stopped_half_way
 

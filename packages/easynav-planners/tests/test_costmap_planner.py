@@ -26,6 +26,7 @@ from easynav.planners.costmap_planner import (
     CostmapPlanner,
     leaves_ahead,
     smooth_path,
+    uninflated,
     without_cells_behind,
 )
 
@@ -343,3 +344,30 @@ def test_leaves_ahead_and_the_blocked_cells_agree():
     up = np.array([[10, 10], [10, 11], [11, 12], [12, 13], [13, 14], [14, 15], [15, 16]])
     right = np.array([[10, 10], [11, 10], [12, 11], [13, 11]])
     assert leaves_ahead(up, np.pi / 2, 6) and not leaves_ahead(right, np.pi / 2, 6)
+
+
+def test_a_costmap_without_inflation_is_warned_about_once(caplog):
+    # The planner keeps off cells of cost >= 253 only: on a costmap without the inscribed band
+    # of an inflation filter its paths graze the walls, and the user is told why.
+    bare = room()
+    bare.data[(bare.data > 0) & (bare.data < 254)] = 0
+    empty = Costmap2D(np.zeros_like(bare.data), 0.05, 0.0, 0.0, "map", 4.5)
+    planner = make_planner()
+    with caplog.at_level("WARNING", logger="easynav"):
+        planner.update(state_with((7.0, 1.0, 0.0), costmap=empty))  # nothing to tell yet
+        assert "InflationFilter" not in caplog.text
+        for _ in range(3):
+            planner.update(state_with((7.0, 1.0, 0.0), costmap=bare))
+    warnings = [r.getMessage() for r in caplog.records if "InflationFilter" in r.getMessage()]
+    assert len(warnings) == 1
+    assert "no inscribed cells (cost 253)" in warnings[0]
+    assert "robot's radius" in warnings[0]
+
+
+def test_an_inflated_costmap_is_not_warned_about(caplog):
+    planner = make_planner()
+    with caplog.at_level("WARNING", logger="easynav"):
+        planner.update(state_with((7.0, 1.0, 0.0)))
+    assert "InflationFilter" not in caplog.text
+    assert uninflated(room().data) is False
+    assert uninflated(np.zeros((3, 3), np.uint8)) is None

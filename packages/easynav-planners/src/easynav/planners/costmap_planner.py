@@ -21,7 +21,7 @@ from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, Pat
 
 __all__ = [
     "DIAGNOSTIC_NAME", "HARDWARE_ID", "CostmapPlanner", "behind", "leaves_ahead",
-    "smooth_path", "without_cells_behind",
+    "smooth_path", "uninflated", "without_cells_behind",
 ]
 #: Width of the moving average that smooths the cell path (the original's 5 points).
 SMOOTHING_WINDOW = 5
@@ -46,6 +46,15 @@ def smooth_path(points: np.ndarray, window: int = SMOOTHING_WINDOW) -> np.ndarra
     i = np.arange(n)
     reach = np.minimum(np.minimum(i, n - 1 - i), half)  # symmetric window, 0 at the ends
     return (cumulative[i + reach + 1] - cumulative[i - reach]) / (2 * reach + 1)[:, None]
+
+
+def uninflated(costs: np.ndarray) -> bool | None:
+    """Whether a costmap's obstacles have no inscribed band: lethal cells (254) and no cell of
+    cost 253, as no inflation filter leaves them. None while it has no lethal cell (nothing to
+    tell yet). A path over an uninflated costmap keeps off the obstacles' own cells only."""
+    if not (costs == 254).any():
+        return None
+    return not (costs == 253).any()
 
 
 def behind(dx: np.ndarray, dy: np.ndarray, yaw: float, radius_cells: int) -> np.ndarray:
@@ -118,6 +127,11 @@ class CostmapPlanner(PathPlannerBase):
     it turns, and having the path flip back under it beside the obstacle (seen on the
     TurtleBot3 sandbox's pillars). 0 gives the original's behaviour.
 
+    Like the original's (and Nav2's planners), the planner knows nothing of the robot's size:
+    the inflation filter of the maps manager keeps paths off walls, by the cells of cost 253
+    within the robot's inscribed radius of an obstacle. The first costmap with obstacles and
+    no such cell (no inflation filter) logs a warning saying so, once per configuration.
+
     ROS (when hosted by a node): publishes ``<fqn>/<alias>/path`` (nav_msgs/Path) while
     subscribed.
 
@@ -159,9 +173,11 @@ class CostmapPlanner(PathPlannerBase):
         self._last_cells: np.ndarray | None = None
         self._last_path: Path | None = None
         self._last_grid: tuple | None = None  # the costmap geometry _last_cells refer to
+        self._inflation_checked = False
 
     def configure_planner(self) -> None:
-        """Warn when A* cannot be compiled."""
+        """Warn when A* cannot be compiled; check the next costmaps' inflation again."""
+        self._inflation_checked = False
         if not compiled_available():
             self.logger.warning(
                 f"{self.plugin_name}: numba is not installed, A* runs in pure Python (tens of "
@@ -211,6 +227,7 @@ class CostmapPlanner(PathPlannerBase):
                     254: "on an obstacle (cost 254)", 255: "on unknown space (cost 255)"}
             self.fail(nav_state, map_frame, f"{goal_text} is {what[goal_cost]} in the costmap")
             return
+        self._check_inflation(costmap)
         cells, cost = astar_costmap(
             costmap.data, (six, siy), (gix, giy),
             self.params.cost_factor, self.params.heuristic_scale,
@@ -228,6 +245,24 @@ class CostmapPlanner(PathPlannerBase):
         self._last_goal, self._last_cells, self._last_path = goal, cells, path
         self._last_grid = grid
         self.write_path(nav_state, path, self._ok_message(goal_text, path))
+
+    def _check_inflation(self, costmap: Costmap2D) -> None:
+        """Warn once when the costmap's obstacles have no inscribed band (:func:`uninflated`):
+        the robot would graze them. Checked until the first costmap with obstacles (two
+        passes over the cells, ~2 ms on 2000 x 2000)."""
+        if self._inflation_checked:
+            return
+        bare = uninflated(costmap.data)
+        if bare is None:
+            return
+        self._inflation_checked = True
+        if bare:
+            self.logger.warning(
+                f"{self.plugin_name}: NavState '{MAP}' has obstacles but no inscribed cells "
+                "(cost 253): no inflation filter made it, and paths keep off the obstacles' "
+                "cells only, not the robot's radius (the planner, as the original's, knows "
+                "nothing of the robot's size). Give the maps manager an InflationFilter."
+            )
 
     def _route_with_hysteresis(self, costmap: Costmap2D, grid: tuple, robot: Odometry, goal,
                                cheapest: np.ndarray, cost: float) -> np.ndarray:
