@@ -77,7 +77,7 @@ def test_no_path_is_warn_then_error_after_debounce():
     set_path(bench.nav_state, 0)
     assert bench.run(0.5).level == WARN
     status = bench.run(0.6)
-    assert status.level == ERROR and "empty path" in status.message
+    assert status.level == ERROR and "the path is empty" in status.message
     set_path(bench.nav_state, 10)
     assert bench.run(0.1).level == OK
 

@@ -36,9 +36,9 @@ class VffController(ControllerMethodBase):
 
     Target: with ``follow_path`` (default) and a non-empty ``path``, the carrot
     ``look_ahead_dist`` metres along the path beyond the robot's projection, and the path's last
-    pose as the goal; an empty ``path`` (the planner found no way) is no target: the robot
-    stops. Without ``follow_path``, or with no ``path`` in NavState at all (no planner writes
-    one), the first of ``goals`` (the original's only target). Field (see
+    pose as the goal; an empty ``path`` (the planner found no way, or has not planned yet) is no
+    target: the robot stops. Without ``follow_path``, or with no ``path`` in NavState at all (no
+    planner is configured), the first of ``goals`` (the original's only target). Field (see
     :class:`VffVectors`): attraction towards the target, of length 1 scaled down within
     ``distance_to_goal`` of the goal (approach slow-down), plus repulsion from the nearest point
     of the ungrouped point perceptions inside the ``obstacle_detection_*`` box (robot footprint
@@ -126,11 +126,12 @@ class VffController(ControllerMethodBase):
         if self.params.follow_path and nav_state.has(PATH):
             path = nav_state.get(PATH, Path)
             if not len(path):
-                # The planner found no way. (Before its first plan there is no path at all,
-                # and the first goal is the target for that cycle or two.) The straight line
-                # to the goal would cross what it found in the way, and the field's repulsion
-                # does not hold a robot off an obstacle on that line: the matrix saw one driven
-                # into a pillar of the TurtleBot3 sandbox while its planner failed.
+                # The planner found no way, or has not planned yet (planner_node sets an
+                # empty path when it activates a planner). The straight line to the goal
+                # would cross what it found in the way, and the field's repulsion does not
+                # hold a robot off an obstacle on that line: the matrix saw one driven into a
+                # pillar of the TurtleBot3 sandbox while its planner failed, and one into a
+                # wall of the home world before the first path.
                 return None
             xy_yaw = path.as_xy_yaw()
             carrot = carrot_on_path(xy_yaw[:, :2], np.array(pose[:2]), self.params.look_ahead_dist)

@@ -17,6 +17,12 @@ class PlannerNode(ComponentNode):
     A path with a non-finite pose is discarded: ``path`` is left empty, so no controller follows
     it, and ``diagnostics.path`` is ERROR (hardware_id planner) until a finite path comes.
 
+    Activating a planner sets ``path`` to an empty path: nothing is planned yet. A controller
+    that drives to the first goal where no planner writes a path (VFF, as the original's) sees
+    that a planner is configured and waits for its first path. Without it, VFF drove straight
+    at the first waypoint, into the wall between, while the non-RT thread was still busy with
+    the OctoMap maps manager building its voxel map (5 s) and the planner had not yet run.
+
     Thread contract: ``cycle`` in the non-RT thread.
     """
 
@@ -29,6 +35,12 @@ class PlannerNode(ComponentNode):
         super().__init__("planner_node", namespace, system, **kwargs)
         self._planned_goals = None
         self._path_rejected = False
+
+    def on_activate(self, state):
+        if self.plugins:
+            frame = self.system.services.tf_info().map_frame
+            self.nav_state.set(PATH, Path(Header(self.now_seconds(), frame), []))
+        return super().on_activate(state)
 
     def cycle(self) -> None:
         """Plan when due or forced by new goals. Non-RT thread."""

@@ -48,5 +48,8 @@ class NoPathEvaluator(EvaluatorBase):
             self._since = now
         waited = now - self._since
         level = DiagnosticLevel.ERROR if waited >= self.debounce_duration else DiagnosticLevel.WARN
-        message = "no path published yet" if path is None else "the planner produced an empty path"
+        message = (
+            "no path published yet" if path is None
+            else "the path is empty (not planned yet, or no way found)"
+        )
         self.publish_diagnostic(nav_state, level, message, {"duration": f"{waited:.2f}"})
