@@ -138,3 +138,38 @@ def test_empty_path_gives_zero():
 def test_bad_parameters_are_named():
     with pytest.raises(ValueError, match="look_ahead_dist = -1"):
         SimplePathFollower(look_ahead_dist=-1.0)
+
+
+def right_angle_path() -> np.ndarray:
+    """(0, 0) to (2, 0), then up to (2, 2): a turn of 90 degrees left at (2, 0)."""
+    a = np.arange(0.0, 2.001, 0.05)
+    return np.vstack((np.column_stack((a, 0 * a)), np.column_stack((2.0 + 0 * a[1:], a[1:]))))
+
+
+@pytest.mark.parametrize(
+    ("x", "distance", "turn"),
+    [(0.0, 1.0, 0.0),            # the corner 2 m ahead, beyond the stretch
+     (1.2, 1.0, math.pi / 2),    # 0.8 m ahead: within it
+     (1.0, 1.0, math.pi / 2),    # exactly 1 m ahead: the leg after it starts there
+     (0.9, 1.0, 0.0)],
+)
+def test_turn_ahead_is_the_largest_turn_within_the_distance(x, distance, turn):
+    from easynav.controllers.path_follower import turn_ahead
+
+    assert turn_ahead(right_angle_path(), np.array([x, 0.05]), distance) == pytest.approx(turn)
+
+
+def test_turn_ahead_from_a_heading_and_on_degenerate_paths():
+    from easynav.controllers.path_follower import turn_ahead
+
+    path = right_angle_path()
+    # Measured from the robot's heading: already turned 30 degrees towards the new leg.
+    assert turn_ahead(path, np.array([1.9, 0.0]), 0.5, heading=math.radians(30)) == (
+        pytest.approx(math.radians(60)))
+    # On the new leg, heading along the old one: the whole turn is still to be made.
+    assert turn_ahead(path, np.array([2.0, 0.5]), 0.5, heading=0.0) == pytest.approx(math.pi / 2)
+    assert turn_ahead(np.array([[1.0, 1.0]]), np.zeros(2), 1.0) == 0.0
+    assert turn_ahead(np.array([[1.0, 1.0], [1.0, 1.0]]), np.zeros(2), 1.0) == 0.0
+    # A U-turn is pi, whichever way round.
+    u_turn = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.2], [0.0, 0.2]])
+    assert turn_ahead(u_turn, np.array([0.5, 0.0]), 1.0) == pytest.approx(math.pi)

@@ -242,3 +242,50 @@ def test_zero_command_without_target_and_deprecated_limits():
 def test_bad_parameters_fail_configuration():
     with pytest.raises(PluginConfigurationError, match="vff.distance_obstacle_detection = 0.0"):
         make_plugin(VffController, "vff", {"distance_obstacle_detection": 0.0}, LIMITS)
+
+
+def right_angle_path() -> np.ndarray:
+    """2 m east from (0, 0), then 2 m north: a right-angle turn left at (2, 0)."""
+    a = np.arange(0.0, 2.001, 0.05)
+    xy = np.vstack((np.column_stack((a, 0 * a)), np.column_stack((2.0 + 0 * a[1:], a[1:]))))
+    yaw = np.append(np.arctan2(*np.diff(xy, axis=0).T[::-1]), math.pi / 2)
+    return np.column_stack((xy, yaw))
+
+
+def test_comes_round_a_right_angle_turn_of_the_path_close_to_the_new_leg():
+    # The field's turn rate (its angle) is lazier than the carrot's arc: at 0.5 m/s the robot
+    # came round 0.25 m off the new leg (into a pillar of the TurtleBot3 sandbox). It now
+    # slows before the turn and turns at least along the carrot's arc.
+    limits = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0, max_linear_acc=0.5,
+                         max_linear_decel=1.0, max_angular_acc=1.0, max_angular_decel=2.0)
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", {"distance_to_goal": 0.5}, limits, clock)
+    nav_state = NavState()
+    path = right_angle_path()
+    set_path(nav_state, path)
+    nav_state.set("goal_tolerance.position", 0.1)
+    nav_state.set("goal_tolerance.yaw", 0.1)
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0)
+    assert run.arrived
+    on_new_leg = [(x, y) for x, y, _ in run.poses if y > 0.4]
+    assert max(abs(x - 2.0) for x, _ in on_new_leg) <= 0.1
+    assert max(x for x, _, _ in run.poses) <= 2.1  # overshoot beyond the corner
+    assert max(v for v, _ in run.commands) == pytest.approx(0.5)  # full speed on the legs
+    assert len(run.poses) * DT <= 12.0  # 9.9 s without slowing down
+    assert_within_limits(run, limits, DT, allow_reverse=False)
+
+
+def test_corner_speed_and_the_pursuit_turn_rate():
+    from easynav.controllers.vff_controller import (
+        CORNER_MIN_SPEED_RATIO,
+        corner_speed,
+        pursuit_turn_rate,
+    )
+
+    assert corner_speed(0.0, 0.5) == 0.5
+    assert corner_speed(math.radians(60), 0.5) == pytest.approx(0.25)
+    assert corner_speed(math.pi / 2, 0.5) == corner_speed(math.pi, 0.5) == (
+        pytest.approx(0.5 * CORNER_MIN_SPEED_RATIO))
+    # A point 1 m away at 30 degrees left: the arc through it has radius 1 m.
+    assert pursuit_turn_rate(0.4, math.radians(30), 1.0) == pytest.approx(0.4)
+    assert pursuit_turn_rate(0.4, -math.radians(30), 1.0) == pytest.approx(-0.4)

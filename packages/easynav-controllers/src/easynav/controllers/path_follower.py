@@ -45,6 +45,36 @@ def carrot_on_path(path_xy: np.ndarray, position: np.ndarray, look_ahead: float)
     return path_xy[segment] + fraction * ab[segment]
 
 
+def turn_ahead(path_xy: np.ndarray, position: np.ndarray, distance: float,
+               heading: float | None = None) -> float:
+    """The largest turn (rad, >= 0) of ``path_xy`` within ``distance`` metres beyond the point
+    closest to ``position``: how far the heading of any segment reaching into that stretch
+    differs from the heading of the segment the robot is on. 0 for a path of fewer than two
+    points (or of zero-length steps only)."""
+    pts = np.asarray(path_xy, dtype=float)
+    if len(pts) < 2:
+        return 0.0
+    ab = np.diff(pts, axis=0)
+    length2 = np.einsum("ij,ij->i", ab, ab)
+    moving = length2 > 1e-18
+    if not moving.any():
+        return 0.0
+    pts_a, ab, length2 = pts[:-1][moving], ab[moving], length2[moving]
+    t = np.clip(np.einsum("ij,ij->i", position - pts_a, ab) / length2, 0.0, 1.0)
+    projections = pts_a + t[:, None] * ab
+    nearest = int(np.argmin(np.einsum("ij,ij->i", projections - position,
+                                      projections - position)))
+    lengths = np.sqrt(length2)
+    # Distance from the projection to the start of each later segment.
+    starts = np.concatenate(([0.0], np.cumsum(lengths[nearest:])))[:-1]
+    starts = starts - t[nearest] * lengths[nearest]
+    reached = nearest + np.flatnonzero(starts <= distance)
+    headings = np.arctan2(ab[reached, 1], ab[reached, 0])
+    here = math.atan2(ab[nearest, 1], ab[nearest, 0]) if heading is None else heading
+    turns = np.abs(np.arctan2(np.sin(headings - here), np.cos(headings - here)))
+    return float(turns.max())
+
+
 def path_segments(path_xy_yaw: np.ndarray) -> list[tuple[int, int, int]]:
     """The path cut at its cusps: ``(first, last, direction)`` index ranges (inclusive), where
     ``direction`` is +1 when the poses are driven forward (the next pose lies ahead of a pose's
