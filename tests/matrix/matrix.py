@@ -463,8 +463,10 @@ def _take_the_filters(section: dict, own: dict) -> None:
     that plans on that costmap (the CostmapPlanner, which like the original's and Nav2's
     planners keeps off lethal and inflated cells only and knows nothing of the robot's size)
     is configured as the file written for planning on it (Bonxai's own) configures it;
-    uninflated, the path ran along walls and the robot hit them (home and TurtleBot3 sandbox,
-    the NavMap stack's four CostmapPlanner rows)."""
+    uninflated, the path ran along walls and the robot hit them (the NavMap stack's
+    CostmapPlanner rows on home and the TurtleBot3 sandbox; the rule changes the 24 rows of
+    that stack and planner). Where the stack's file is the member's representative one (a row
+    in the world the stack's file was written for), the member's section already is its own."""
     if section.get("filters") or not own.get("filters"):
         return
     section["filters"] = list(own["filters"])

@@ -371,3 +371,15 @@ def test_an_inflated_costmap_is_not_warned_about(caplog):
     assert "InflationFilter" not in caplog.text
     assert uninflated(room().data) is False
     assert uninflated(np.zeros((3, 3), np.uint8)) is None
+
+
+def test_on_a_map_coarser_than_the_robot_graded_costs_are_inflation_enough():
+    # Inscribed radius 0.25 m on 0.3 m cells: an inflation filter raises no cell to 253, only
+    # grades them. Graded cells mean a filter ran; none at all mean none did.
+    walls = np.zeros((20, 20), np.uint8)
+    walls[10, :] = 254
+    graded = walls.copy()
+    graded[9, :] = graded[11, :] = 120
+    assert uninflated(graded, band_cells=True) is True
+    assert uninflated(graded, band_cells=False) is False
+    assert uninflated(walls, band_cells=False) is True

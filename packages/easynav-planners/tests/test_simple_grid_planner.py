@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from easynav.maps import SimpleMap, resolve_map_file
-from easynav.planners import SimpleGridPlanner
+from easynav.planners import SimpleGridPlanner, astar_8connected
 
 
 def room(width_m=6.0, height_m=4.0, res=0.05) -> SimpleMap:
@@ -100,3 +100,34 @@ def test_every_room_of_the_shipped_house_is_reachable_from_the_start(goal):
 def test_bad_parameters_are_refused():
     with pytest.raises(ValueError, match="clearance_distance = -1"):
         SimpleGridPlanner(0.3, -1.0)
+
+
+def pillars() -> SimpleMap:
+    """Two pillars of the TurtleBot3 sandbox 1 m apart (0.4 x 0.35 m), in a 4 x 4 m room."""
+    world = room(4.0, 4.0)
+    world.cells[48:55, 47:55] = True   # x 2.35-2.75, y 2.40-2.75
+    world.cells[49:56, 25:33] = True   # x 1.25-1.65, y 2.45-2.80
+    return world
+
+
+def test_a_start_in_a_pillars_clearance_leaves_it_without_passing_closer_to_the_next():
+    # Where the sandbox's robot stood after turning at a waypoint, 0.28 m from a pillar: the
+    # shortcut from its cell ran through the next pillar's clearance to 0.09 m of it (the
+    # robot's radius is 0.15 m), and the robot following it hit the pillar.
+    world = pillars()
+    start = (2.12, 2.86)
+    assert 0.2 < clearance_along(world, np.array([start, start])) < 0.3
+    result = SimpleGridPlanner(0.15, 0.2).plan(world, start, (1.0, 1.0, 0.0))
+    assert result.ok, result.reason
+    assert clearance_along(world, result.poses) >= 0.25
+
+
+def test_a_start_in_the_clearance_leaves_it_by_the_shortest_way_out():
+    from easynav.planners.grid_astar import CLEARANCE, COLLISION, FREE, OBSTACLE
+
+    # A wall along y = 0, its clearance in rows 1-3; the start in it, the goal far along it.
+    levels = np.full((10, 30), FREE, dtype=np.int8)
+    levels[0], levels[1], levels[2:4] = OBSTACLE, COLLISION, CLEARANCE
+    cells = astar_8connected(levels, (2, 2), (27, 4))
+    assert [levels[y, x] for x, y in cells[2:]] == [FREE] * (len(cells) - 2)  # out first
+    assert all(y == 4 for _, y in cells[2:])  # then straight on along the clearance's edge

@@ -48,13 +48,17 @@ def smooth_path(points: np.ndarray, window: int = SMOOTHING_WINDOW) -> np.ndarra
     return (cumulative[i + reach + 1] - cumulative[i - reach]) / (2 * reach + 1)[:, None]
 
 
-def uninflated(costs: np.ndarray) -> bool | None:
-    """Whether a costmap's obstacles have no inscribed band: lethal cells (254) and no cell of
-    cost 253, as no inflation filter leaves them. None while it has no lethal cell (nothing to
-    tell yet). A path over an uninflated costmap keeps off the obstacles' own cells only."""
+def uninflated(costs: np.ndarray, band_cells: bool = True) -> bool | None:
+    """Whether a costmap's obstacles were left uninflated: lethal cells (254) and no cell of
+    cost 253, as no inflation filter leaves them. With ``band_cells`` false (the robot's
+    inscribed radius is less than a cell, so an inflation filter raises no cell to 253), no
+    cell of a graded cost (1-253) either. None while it has no lethal cell (nothing to tell
+    yet). A path over an uninflated costmap keeps off the obstacles' own cells only."""
     if not (costs == 254).any():
         return None
-    return not (costs == 253).any()
+    if band_cells:
+        return not (costs == 253).any()
+    return not ((costs > 0) & (costs < 254)).any()
 
 
 def behind(dx: np.ndarray, dy: np.ndarray, yaw: float, radius_cells: int) -> np.ndarray:
@@ -130,7 +134,8 @@ class CostmapPlanner(PathPlannerBase):
     Like the original's (and Nav2's planners), the planner knows nothing of the robot's size:
     the inflation filter of the maps manager keeps paths off walls, by the cells of cost 253
     within the robot's inscribed radius of an obstacle. The first costmap with obstacles and
-    no such cell (no inflation filter) logs a warning saying so, once per configuration.
+    no such cell (no inflation filter; no graded cell either when the inscribed radius is less
+    than a cell) logs a warning saying so, once per configuration.
 
     ROS (when hosted by a node): publishes ``<fqn>/<alias>/path`` (nav_msgs/Path) while
     subscribed.
@@ -247,21 +252,26 @@ class CostmapPlanner(PathPlannerBase):
         self.write_path(nav_state, path, self._ok_message(goal_text, path))
 
     def _check_inflation(self, costmap: Costmap2D) -> None:
-        """Warn once when the costmap's obstacles have no inscribed band (:func:`uninflated`):
+        """Warn once when the costmap's obstacles were left uninflated (:func:`uninflated`):
         the robot would graze them. Checked until the first costmap with obstacles (two
         passes over the cells, ~2 ms on 2000 x 2000)."""
         if self._inflation_checked:
             return
-        bare = uninflated(costmap.data)
+        inscribed = float(self.get_robot_geometry().inscribed_radius)
+        band_cells = inscribed >= costmap.resolution
+        bare = uninflated(costmap.data, band_cells)
         if bare is None:
             return
         self._inflation_checked = True
         if bare:
+            missing = ("no inscribed cells (cost 253)" if band_cells
+                       else "no inflated cells (cost 1-253)")
             self.logger.warning(
-                f"{self.plugin_name}: NavState '{MAP}' has obstacles but no inscribed cells "
-                "(cost 253): no inflation filter made it, and paths keep off the obstacles' "
-                "cells only, not the robot's radius (the planner, as the original's, knows "
-                "nothing of the robot's size). Give the maps manager an InflationFilter."
+                f"{self.plugin_name}: NavState '{MAP}' has obstacles but {missing}: no "
+                "inflation filter made it, and paths keep off the obstacles' cells only, not "
+                f"the robot's radius (inscribed {inscribed:.2f} m; the planner, as the "
+                "original's, knows nothing of the robot's size). Give the maps manager an "
+                "InflationFilter."
             )
 
     def _route_with_hysteresis(self, costmap: Costmap2D, grid: tuple, robot: Odometry, goal,

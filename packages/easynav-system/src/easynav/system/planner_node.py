@@ -17,11 +17,13 @@ class PlannerNode(ComponentNode):
     A path with a non-finite pose is discarded: ``path`` is left empty, so no controller follows
     it, and ``diagnostics.path`` is ERROR (hardware_id planner) until a finite path comes.
 
-    Activating a planner sets ``path`` to an empty path: nothing is planned yet. A controller
-    that drives to the first goal where no planner writes a path (VFF, as the original's) sees
-    that a planner is configured and waits for its first path. Without it, VFF drove straight
-    at the first waypoint, into the wall between, while the non-RT thread was still busy with
-    the OctoMap maps manager building its voxel map (5 s) and the planner had not yet run.
+    Activating a planner that writes ``path`` (its ``WRITES``: every path planner; not the
+    Dummy planner) sets ``path`` to an empty path: nothing is planned yet. A controller that
+    drives to the first goal where no planner writes a path (VFF, as the original's) sees that
+    a path will come and waits for it; without such a planner ``path`` is erased. Before, VFF
+    drove straight at the first waypoint, into the wall between, while the non-RT thread was
+    still busy with the OctoMap maps manager building its voxel map (5 s) and the planner had
+    not yet run.
 
     Thread contract: ``cycle`` in the non-RT thread.
     """
@@ -37,9 +39,11 @@ class PlannerNode(ComponentNode):
         self._path_rejected = False
 
     def on_activate(self, state):
-        if self.plugins:
+        if any(PATH in lp.plugin.WRITES for lp in self.plugins):
             frame = self.system.services.tf_info().map_frame
             self.nav_state.set(PATH, Path(Header(self.now_seconds(), frame), []))
+        elif self.nav_state.has(PATH):
+            self.nav_state.erase(PATH)  # one from before a reconfiguration without a planner
         return super().on_activate(state)
 
     def cycle(self) -> None:

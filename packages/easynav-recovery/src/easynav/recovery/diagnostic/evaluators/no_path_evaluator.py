@@ -49,7 +49,7 @@ class NoPathEvaluator(EvaluatorBase):
         waited = now - self._since
         level = DiagnosticLevel.ERROR if waited >= self.debounce_duration else DiagnosticLevel.WARN
         message = (
-            "no path published yet" if path is None
+            "no path (no planner writes one)" if path is None
             else "the path is empty (not planned yet, or no way found)"
         )
         self.publish_diagnostic(nav_state, level, message, {"duration": f"{waited:.2f}"})
