@@ -150,7 +150,7 @@ def right_angle_path() -> np.ndarray:
     ("x", "distance", "turn"),
     [(0.0, 1.0, 0.0),            # the corner 2 m ahead, beyond the stretch
      (1.2, 1.0, math.pi / 2),    # 0.8 m ahead: within it
-     (1.0, 1.0, math.pi / 2),    # exactly 1 m ahead: the leg after it starts there
+     (1.0, 1.01, math.pi / 2),   # just within 1.01 m: the leg after it starts there
      (0.9, 1.0, 0.0)],
 )
 def test_turn_ahead_is_the_largest_turn_within_the_distance(x, distance, turn):

@@ -275,6 +275,38 @@ def test_comes_round_a_right_angle_turn_of_the_path_close_to_the_new_leg():
     assert_within_limits(run, limits, DT, allow_reverse=False)
 
 
+def test_keeps_off_a_pillar_beside_the_leg_after_a_right_angle_turn():
+    # Among obstacles the repulsion is on and the slow-down before the turn does the work:
+    # with the playground's field (0.7 m, from the robot's centre forwards) the robot came
+    # round the turn to 0.11 m of a pillar beside the new leg.
+    limits = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0, max_linear_acc=0.5,
+                         max_linear_decel=1.0, max_angular_acc=1.0, max_angular_decel=2.0)
+    params = {"distance_to_goal": 0.5, "distance_obstacle_detection": 0.7,
+              "obstacle_detection_x_min": 0.0}
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", params, limits, clock)
+    nav_state = NavState()
+    set_path(nav_state, right_angle_path())
+    nav_state.set("goal_tolerance.position", 0.1)
+    nav_state.set("goal_tolerance.yaw", 0.1)
+    side = np.linspace(-0.1, 0.1, 7)
+    pillar = np.array([(2.4 + u, 0.8 + v) for u in side for v in side
+                       if abs(u) == 0.1 or abs(v) == 0.1])  # a 0.2 m square
+
+    def scan(nav, pose):
+        x, y, yaw = pose
+        rel = pillar - (x, y)
+        c, s = math.cos(yaw), math.sin(yaw)
+        local = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
+        nav.set("scan", PointPerception(np.column_stack((local, np.full(len(local), 0.3))),
+                                        "base_footprint", clock.t))
+
+    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
+    assert run.arrived
+    clearance = min(np.min(np.hypot(pillar[:, 0] - x, pillar[:, 1] - y)) for x, y, _ in run.poses)
+    assert clearance >= 0.18
+
+
 def test_corner_speed_and_the_pursuit_turn_rate():
     from easynav.controllers.vff_controller import (
         CORNER_MIN_SPEED_RATIO,

@@ -48,11 +48,12 @@ def carrot_on_path(path_xy: np.ndarray, position: np.ndarray, look_ahead: float)
 def turn_ahead(path_xy: np.ndarray, position: np.ndarray, distance: float,
                heading: float | None = None) -> float:
     """The largest turn (rad, >= 0) of ``path_xy`` within ``distance`` metres beyond the point
-    closest to ``position``: how far the heading of any segment reaching into that stretch
-    differs from the heading of the segment the robot is on. 0 for a path of fewer than two
-    points (or of zero-length steps only)."""
+    closest to ``position``: how far the heading of any segment starting in that stretch (or
+    holding the closest point) differs from ``heading`` (the robot's, rad), by default the
+    heading of the segment holding the closest point. 0 for a path of fewer than two points
+    (or of zero-length steps only) and for a position that is not finite."""
     pts = np.asarray(path_xy, dtype=float)
-    if len(pts) < 2:
+    if len(pts) < 2 or not np.isfinite(position).all():
         return 0.0
     ab = np.diff(pts, axis=0)
     length2 = np.einsum("ij,ij->i", ab, ab)

@@ -25,9 +25,9 @@ FOLLOWING, ALIGNING, ARRIVED, NO_GOAL = "following", "aligning", "arrived", "no_
 
 #: A commanded speed (m/s) below which the robot counts as standing (see update_rt).
 STANDSTILL = 0.01
-#: The least share of the top speed :func:`corner_speed` allows, however sharp the turn: a
-#: robot at a quarter of 0.5 m/s came round a right-angle turn of the path within 0.09 m of
-#: its new leg (0.25 m at full speed), 13 % slower over the turn.
+#: The least share of the top speed :func:`corner_speed` allows, however sharp the turn:
+#: with it (and the pursuit turn rate) a robot at up to 0.5 m/s came round a right-angle turn
+#: of the path within 0.09 m of its new leg (0.25 m before either), its 4 m run 13 % slower.
 CORNER_MIN_SPEED_RATIO = 0.25
 
 
@@ -139,8 +139,10 @@ class VffController(ControllerMethodBase):
         """The limits in force (``get_robot_limits()``), read every cycle."""
         return self.get_robot_limits()
 
-    def target(self, nav_state: NavState, pose) -> tuple[np.ndarray, np.ndarray] | None:
-        """``(carrot xy, goal xy-yaw)`` or None without a target."""
+    def target(self, nav_state: NavState, pose
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None] | None:
+        """``(carrot xy, goal xy-yaw, the path's (N, 2) xy or None)`` or None without a
+        target."""
         if self.params.follow_path and nav_state.has(PATH):
             path = nav_state.get(PATH, Path)
             if not len(path):
@@ -153,27 +155,24 @@ class VffController(ControllerMethodBase):
                 return None
             xy_yaw = path.as_xy_yaw()
             carrot = carrot_on_path(xy_yaw[:, :2], np.array(pose[:2]), self.params.look_ahead_dist)
-            return carrot, xy_yaw[-1]
+            return carrot, xy_yaw[-1], xy_yaw[:, :2]
         if nav_state.has(GOALS):
             goals = nav_state.get(GOALS, Goals)
             if len(goals):
                 goal = goals.goals[0].pose
                 xy_yaw = np.array((goal.x, goal.y, goal.yaw))
-                return xy_yaw[:2], xy_yaw
+                return xy_yaw[:2], xy_yaw, None
         return None
 
-    def _corner_speed(self, nav_state: NavState, pose, limits: RobotLimits) -> float:
+    def _corner_speed(self, path_xy: np.ndarray | None, pose, limits: RobotLimits) -> float:
         """:func:`corner_speed` for the largest turn of the path off the robot's heading within
         ``look_ahead_dist`` plus the braking distance at the last speed; no limit without a
         path to follow."""
-        if not (self.params.follow_path and nav_state.has(PATH)):
-            return math.inf
-        path = nav_state.get(PATH, Path)
-        if len(path) < 2:
+        if path_xy is None or len(path_xy) < 2:
             return math.inf
         braking = self._last[0] ** 2 / (2.0 * max(limits.max_linear_decel, 1e-6))
-        turn = turn_ahead(path.as_xy_yaw()[:, :2], np.array(pose[:2]),
-                          self.params.look_ahead_dist + braking, heading=pose[2])
+        turn = turn_ahead(path_xy, np.array(pose[:2]), self.params.look_ahead_dist + braking,
+                          heading=pose[2])
         return corner_speed(turn, limits.max_linear_vel)
 
     def obstacle_points(self, nav_state: NavState) -> np.ndarray:
@@ -218,7 +217,7 @@ class VffController(ControllerMethodBase):
             dt = 1.0 / self.rt_freq
         self._last_time = now
         limits = self.limits()
-        carrot, goal = target
+        carrot, goal, path_xy = target
         p = self.params
         pos_tol = float(nav_state.get_or(GOAL_TOLERANCE_POSITION, p.fallback_goal_pos_tol))
         yaw_tol = float(nav_state.get_or(GOAL_TOLERANCE_YAW, p.fallback_goal_yaw_tol))
@@ -262,9 +261,12 @@ class VffController(ControllerMethodBase):
             # original's) is lazier than that arc: leaving a right-angle turn of the path at
             # 0.5 m/s the robot came round 0.25 m off the new leg, into a pillar of the
             # TurtleBot3 sandbox (integration matrix). Not against the repulsion, which
-            # holds the robot off what the carrot's arc would cut.
-            v = min(v, self._corner_speed(nav_state, pose, limits))
-            if self.vectors.repulsive == (0.0, 0.0):
+            # holds the robot off what the carrot's arc would cut; nor once the carrot is the
+            # goal, where the arc tightens as the robot closes in and it would hook into the
+            # goal off its yaw.
+            v = min(v, self._corner_speed(path_xy, pose, limits))
+            if (self.vectors.repulsive == (0.0, 0.0) and path_xy is not None
+                    and dist > self.params.look_ahead_dist):
                 pursuit = pursuit_turn_rate(
                     v, _wrap(bearing - pose[2]),
                     math.hypot(carrot[0] - pose[0], carrot[1] - pose[1]))

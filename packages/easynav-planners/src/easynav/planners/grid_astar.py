@@ -43,7 +43,8 @@ def octile_distance(ax: int, ay: int, bx: int, by: int) -> float:
 def astar_8connected(
     levels: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
 ) -> list[tuple[int, int]] | None:
-    """The shortest 8-connected cell path from ``start`` to ``goal``, or None when there is none.
+    """The cheapest 8-connected cell path from ``start`` to ``goal``, or None when there is none
+    (from a free start, the shortest).
 
     ``levels[y, x]`` is a danger level (:data:`FREE` … :data:`OBSTACLE`). A move may not enter an
     obstacle and never goes deeper into danger than the cell it leaves (``level[to] <=
