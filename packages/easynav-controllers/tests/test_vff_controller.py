@@ -28,7 +28,25 @@ from easynav.core.robot import RobotLimits
 from easynav.core.types import Goals, Header, Pose, PoseStamped, TwistStamped
 
 LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0)
+#: The playground's robot: its accelerations too.
+PLAYGROUND_LIMITS = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0, max_linear_acc=0.5,
+                                max_linear_decel=1.0, max_angular_acc=1.0, max_angular_decel=2.0)
 DT = 0.05
+
+
+def scanner(obstacle_xy: np.ndarray, clock: Clock):
+    """A ``before_step`` that writes the points ``obstacle_xy`` (map frame) as the laser sees
+    them from the robot's pose (robot footprint frame, 0.3 m high)."""
+
+    def scan(nav, pose):
+        x, y, yaw = pose
+        rel = obstacle_xy - (x, y)
+        c, s = math.cos(yaw), math.sin(yaw)
+        local = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
+        nav.set("scan", PointPerception(np.column_stack((local, np.full(len(local), 0.3))),
+                                        "base_footprint", clock.t))
+
+    return scan
 
 
 def test_field_matches_the_original():
@@ -137,13 +155,7 @@ def test_avoids_a_wall_next_to_the_path():
     set_path(nav_state, path)
     wall = wall_points()
 
-    def scan(nav, pose):
-        x, y, yaw = pose
-        rel = wall - (x, y)
-        c, s = math.cos(yaw), math.sin(yaw)
-        local = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
-        points = np.column_stack((local, np.full(len(local), 0.3)))
-        nav.set("scan", PointPerception(points, "base_footprint", clock.t))
+    scan = scanner(wall, clock)
 
     run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
     assert run.arrived
@@ -169,13 +181,7 @@ def test_a_wall_behind_the_goal_does_not_hold_the_robot_short_of_it():
     ys = np.arange(-1.0, 1.01, 0.05)
     wall = np.column_stack((np.full_like(ys, 2.2), ys))
 
-    def scan(nav, pose):
-        x, y, yaw = pose
-        rel = wall - (x, y)
-        c, s = math.cos(yaw), math.sin(yaw)
-        local = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
-        nav.set("scan", PointPerception(np.column_stack((local, np.full(len(local), 0.3))),
-                                        "base_footprint", clock.t))
+    scan = scanner(wall, clock)
 
     run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
     assert run.arrived, run.final
@@ -256,8 +262,7 @@ def test_comes_round_a_right_angle_turn_of_the_path_close_to_the_new_leg():
     # The field's turn rate (its angle) is lazier than the carrot's arc: at 0.5 m/s the robot
     # came round 0.25 m off the new leg (into a pillar of the TurtleBot3 sandbox). It now
     # slows before the turn and turns at least along the carrot's arc.
-    limits = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0, max_linear_acc=0.5,
-                         max_linear_decel=1.0, max_angular_acc=1.0, max_angular_decel=2.0)
+    limits = PLAYGROUND_LIMITS
     clock = Clock()
     vff = make_plugin(VffController, "vff", {"distance_to_goal": 0.5}, limits, clock)
     nav_state = NavState()
@@ -279,8 +284,7 @@ def test_keeps_off_a_pillar_beside_the_leg_after_a_right_angle_turn():
     # Among obstacles the repulsion is on and the slow-down before the turn does the work:
     # with the playground's field (0.7 m, from the robot's centre forwards) the robot came
     # round the turn to 0.11 m of a pillar beside the new leg.
-    limits = RobotLimits(max_linear_vel=0.5, max_angular_vel=1.0, max_linear_acc=0.5,
-                         max_linear_decel=1.0, max_angular_acc=1.0, max_angular_decel=2.0)
+    limits = PLAYGROUND_LIMITS
     params = {"distance_to_goal": 0.5, "distance_obstacle_detection": 0.7,
               "obstacle_detection_x_min": 0.0}
     clock = Clock()
@@ -293,13 +297,7 @@ def test_keeps_off_a_pillar_beside_the_leg_after_a_right_angle_turn():
     pillar = np.array([(2.4 + u, 0.8 + v) for u in side for v in side
                        if abs(u) == 0.1 or abs(v) == 0.1])  # a 0.2 m square
 
-    def scan(nav, pose):
-        x, y, yaw = pose
-        rel = pillar - (x, y)
-        c, s = math.cos(yaw), math.sin(yaw)
-        local = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
-        nav.set("scan", PointPerception(np.column_stack((local, np.full(len(local), 0.3))),
-                                        "base_footprint", clock.t))
+    scan = scanner(pillar, clock)
 
     run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
     assert run.arrived
