@@ -49,6 +49,19 @@ def scanner(obstacle_xy: np.ndarray, clock: Clock):
     return scan
 
 
+def drive_along(path: np.ndarray, params: dict, limits: RobotLimits, obstacle_xy=None):
+    """A closed-loop run of VFF (``params``) along ``path`` to its end (0.1 m and 0.1 rad
+    tolerances), with the laser seeing ``obstacle_xy`` when given."""
+    clock = Clock()
+    vff = make_plugin(VffController, "vff", params, limits, clock)
+    nav_state = NavState()
+    set_path(nav_state, path)
+    nav_state.set("goal_tolerance.position", 0.1)
+    nav_state.set("goal_tolerance.yaw", 0.1)
+    scan = None if obstacle_xy is None else scanner(obstacle_xy, clock)
+    return run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
+
+
 def test_field_matches_the_original():
     # Goal 30 degrees left, nearest point 1 m ahead-right: repulsion of length 3 - 1 = 2 away.
     points = np.array([[0.8, -0.6], [3.0, 2.0]])
@@ -65,14 +78,8 @@ def test_field_matches_the_original():
 
 @pytest.mark.parametrize(("make_path", "deviation"), [(straight_path, 0.05), (curved_path, 0.2)])
 def test_follows_the_path_and_stops_at_the_goal(make_path, deviation):
-    clock = Clock()
-    vff = make_plugin(VffController, "vff", {}, LIMITS, clock)
-    nav_state = NavState()
     path = make_path()
-    set_path(nav_state, path)
-    nav_state.set("goal_tolerance.position", 0.1)
-    nav_state.set("goal_tolerance.yaw", 0.1)
-    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0)
+    run = drive_along(path, {}, LIMITS)
     assert run.arrived
     x, y, yaw = run.final
     assert math.hypot(x - path[-1, 0], y - path[-1, 1]) <= 0.1
@@ -262,44 +269,26 @@ def test_comes_round_a_right_angle_turn_of_the_path_close_to_the_new_leg():
     # The field's turn rate (its angle) is lazier than the carrot's arc: at 0.5 m/s the robot
     # came round 0.25 m off the new leg (into a pillar of the TurtleBot3 sandbox). It now
     # slows before the turn and turns at least along the carrot's arc.
-    limits = PLAYGROUND_LIMITS
-    clock = Clock()
-    vff = make_plugin(VffController, "vff", {"distance_to_goal": 0.5}, limits, clock)
-    nav_state = NavState()
-    path = right_angle_path()
-    set_path(nav_state, path)
-    nav_state.set("goal_tolerance.position", 0.1)
-    nav_state.set("goal_tolerance.yaw", 0.1)
-    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0)
+    run = drive_along(right_angle_path(), {"distance_to_goal": 0.5}, PLAYGROUND_LIMITS)
     assert run.arrived
     on_new_leg = [(x, y) for x, y, _ in run.poses if y > 0.4]
     assert max(abs(x - 2.0) for x, _ in on_new_leg) <= 0.1
     assert max(x for x, _, _ in run.poses) <= 2.1  # overshoot beyond the corner
     assert max(v for v, _ in run.commands) == pytest.approx(0.5)  # full speed on the legs
     assert len(run.poses) * DT <= 12.0  # 9.9 s without slowing down
-    assert_within_limits(run, limits, DT, allow_reverse=False)
+    assert_within_limits(run, PLAYGROUND_LIMITS, DT, allow_reverse=False)
 
 
 def test_keeps_off_a_pillar_beside_the_leg_after_a_right_angle_turn():
     # Among obstacles the repulsion is on and the slow-down before the turn does the work:
     # with the playground's field (0.7 m, from the robot's centre forwards) the robot came
     # round the turn to 0.11 m of a pillar beside the new leg.
-    limits = PLAYGROUND_LIMITS
     params = {"distance_to_goal": 0.5, "distance_obstacle_detection": 0.7,
               "obstacle_detection_x_min": 0.0}
-    clock = Clock()
-    vff = make_plugin(VffController, "vff", params, limits, clock)
-    nav_state = NavState()
-    set_path(nav_state, right_angle_path())
-    nav_state.set("goal_tolerance.position", 0.1)
-    nav_state.set("goal_tolerance.yaw", 0.1)
     side = np.linspace(-0.1, 0.1, 7)
     pillar = np.array([(2.4 + u, 0.8 + v) for u in side for v in side
                        if abs(u) == 0.1 or abs(v) == 0.1])  # a 0.2 m square
-
-    scan = scanner(pillar, clock)
-
-    run = run_closed_loop(vff, nav_state, clock, dt=DT, t_max=60.0, before_step=scan)
+    run = drive_along(right_angle_path(), params, PLAYGROUND_LIMITS, pillar)
     assert run.arrived
     clearance = min(np.min(np.hypot(pillar[:, 0] - x, pillar[:, 1] - y)) for x, y, _ in run.poses)
     assert clearance >= 0.18
