@@ -55,23 +55,16 @@ def turn_ahead(path_xy: np.ndarray, position: np.ndarray, distance: float,
     pts = np.asarray(path_xy, dtype=float)
     if len(pts) < 2 or not np.isfinite(position).all():
         return 0.0
-    ab = np.diff(pts, axis=0)
-    length2 = np.einsum("ij,ij->i", ab, ab)
-    moving = length2 > 1e-18
-    if not moving.any():
+    nearest, t, _ = project_on_path(pts, np.asarray(position, dtype=float), 0, len(pts) - 1)
+    ab = np.diff(pts[nearest:], axis=0)
+    lengths = np.hypot(ab[:, 0], ab[:, 1])
+    # Distance from the projection to the start of each segment from the robot's on.
+    starts = np.concatenate(([0.0], np.cumsum(lengths)))[:-1] - t * lengths[0]
+    reached = (starts <= distance) & (lengths > 1e-9)
+    if not reached.any():
         return 0.0
-    pts_a, ab, length2 = pts[:-1][moving], ab[moving], length2[moving]
-    t = np.clip(np.einsum("ij,ij->i", position - pts_a, ab) / length2, 0.0, 1.0)
-    projections = pts_a + t[:, None] * ab
-    nearest = int(np.argmin(np.einsum("ij,ij->i", projections - position,
-                                      projections - position)))
-    lengths = np.sqrt(length2)
-    # Distance from the projection to the start of each later segment.
-    starts = np.concatenate(([0.0], np.cumsum(lengths[nearest:])))[:-1]
-    starts = starts - t[nearest] * lengths[nearest]
-    reached = nearest + np.flatnonzero(starts <= distance)
     headings = np.arctan2(ab[reached, 1], ab[reached, 0])
-    here = math.atan2(ab[nearest, 1], ab[nearest, 0]) if heading is None else heading
+    here = headings[0] if heading is None else heading
     turns = np.abs(np.arctan2(np.sin(headings - here), np.cos(headings - here)))
     return float(turns.max())
 
