@@ -9,7 +9,15 @@ import numpy as np
 from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import GOALS, ROBOT_POSE
 from easynav.core.plugins import Param
-from easynav.core.types import Costmap2D, Header, Odometry, Path
+from easynav.core.types import (
+    FREE_SPACE,
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    Costmap2D,
+    Header,
+    Odometry,
+    Path,
+)
 from easynav.maps.costmap.keys import MAP, MAP_BASE, MAP_TIME
 from easynav.planners.costmap_astar import (
     BLOCKED_COST,
@@ -54,11 +62,11 @@ def uninflated(costs: np.ndarray, band_cells: bool = True) -> bool | None:
     inscribed radius is less than a cell, so an inflation filter raises no cell to 253), no
     cell of a graded cost (1-253) either. None while it has no lethal cell (nothing to tell
     yet). A path over an uninflated costmap keeps off the obstacles' own cells only."""
-    if not (costs == 254).any():
+    if not (costs == LETHAL_OBSTACLE).any():
         return None
     if band_cells:
-        return not (costs == 253).any()
-    return not ((costs > 0) & (costs < 254)).any()
+        return not (costs == INSCRIBED_INFLATED_OBSTACLE).any()
+    return not ((costs > FREE_SPACE) & (costs < LETHAL_OBSTACLE)).any()
 
 
 def behind(dx: np.ndarray, dy: np.ndarray, yaw: float, radius_cells: int) -> np.ndarray:
