@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from easynav.localizers import ParticleFilter2D, hit_fractions
+from easynav.localizers.particle_filter import place_clusters
 from easynav.maps import SimpleMap
 
 
@@ -149,14 +150,14 @@ def test_redrawn_particles_count_in_the_estimate_once_weighed():
     assert pf.poses[:100, 0].tolist() == [9.0] * 100
     assert pf.weights.sum() == pytest.approx(1.0)
     assert pf.estimate() == pytest.approx((1.0, 1.0, 0.0))
-    # The next measurement weighs them: where it favours them, the estimate follows.
+    # The next measurement weighs them: where it favours them, the estimate follows (to the
+    # place with the most weight: the upper half holds both places, 100 × 100 against 100 × 1).
     assert pf.correct(np.where(pf.poses[:, 0] == 9.0, 100.0, 1.0))
     assert pf.unweighed is None
-    favoured = (100 * 100 * 9.0 + 100 * 1.0) / (100 * 100 + 100)  # the upper half: 100 + 100
-    assert pf.estimate()[0] == pytest.approx(favoured)
+    assert pf.estimate()[0] == pytest.approx(9.0)
     # Weights from scratch (set_weights) weigh them too; resampling forgets the mark.
     pf.redraw(np.arange(300, 400), np.tile((5.0, 5.0, 0.0), (100, 1)))
-    assert pf.estimate()[0] == pytest.approx(favoured)
+    assert pf.estimate()[0] == pytest.approx(9.0)
     assert pf.set_weights(np.where(pf.poses[:, 0] == 5.0, 1.0, 0.0))
     assert pf.estimate()[0] == pytest.approx(5.0)
     pf.redraw(np.arange(10), np.zeros((10, 3)))
@@ -219,3 +220,60 @@ def test_a_scan_that_lands_inside_a_filled_block_no_longer_fits():
         # Every occupied cell counted, this scored 1.0 as well; now only the points that land
         # near the block's other faces (its ends at y 2 and 6) count, a little.
         assert inside[0] < 0.1
+
+
+def test_place_clusters_group_touching_cells():
+    xy = np.array([[0.0, 0.0], [0.3, 0.2], [0.9, 0.4], [5.0, 5.0], [5.2, 4.9], [1.4, 0.6]])
+    # 0.5 m cells: the first three and the last touch (cells (0,0), (1,0), (2,1)); the two at
+    # (5, 5) are another place.
+    assert place_clusters(xy).tolist() == [0, 0, 0, 1, 1, 0]
+    assert place_clusters(xy[:1]).tolist() == [0]
+    assert place_clusters(np.zeros((0, 2))).tolist() == []
+    # A cloud over a huge span still clusters (on a coarser grid), in bounded memory.
+    assert place_clusters(np.array([[0.0, 0.0], [1e6, 1e6], [0.1, 0.0]])).tolist() == [0, 1, 0]
+
+
+def test_estimate_is_the_heaviest_place_not_the_mean_between_places():
+    # A kidnapped robot's cloud after a redraw: most weight at (8, 6), a look-alike at
+    # (22, 9) facing the other way. The mean of the upper half lay between them, 0.5 m off
+    # with 4 % at the look-alike; the estimate is the heavier place's.
+    rng = np.random.default_rng(0)
+    pf = filter_with(1000)
+    pf.poses[:960] = (8.0, 6.0, math.pi) + rng.normal(0.0, 0.05, (960, 3))
+    pf.poses[960:] = (22.0, 9.0, 0.0) + rng.normal(0.0, 0.05, (40, 3))
+    pf.weights[:] = 1.0 / 1000
+    x, y, yaw = pf.estimate()
+    assert math.hypot(x - 8.0, y - 6.0) < 0.01
+    assert abs(abs(yaw) - math.pi) < 0.01
+    # The heavier place wins even when it holds fewer particles.
+    pf.weights[:960] = 0.1 / 960
+    pf.weights[960:] = 0.9 / 40
+    x, y, _ = pf.estimate()
+    assert math.hypot(x - 22.0, y - 9.0) < 0.02
+
+
+def test_reseed_keeps_each_copy_at_its_own_place():
+    # Two places 14 m apart in the upper half: the copies are jittered with their place's
+    # spread (here the floor min_noise_xy), not with the 7 m spread across both places.
+    rng = np.random.default_rng(1)
+    pf = filter_with(2000)
+    pf.poses[:600] = (8.0, 6.0, 0.0) + rng.normal(0.0, 0.05, (600, 3))
+    pf.poses[600:1000] = (22.0, 9.0, 0.0) + rng.normal(0.0, 0.05, (400, 3))
+    pf.poses[1000:] = (15.0, 1.0, 0.0)
+    pf.weights[:1000] = 1.0
+    pf.weights[1000:] = 0.001
+    pf.weights /= pf.weights.sum()
+    pf.reseed_worst_half(0.05, 0.05)
+    near = np.minimum(np.hypot(pf.poses[:, 0] - 8.0, pf.poses[:, 1] - 6.0),
+                      np.hypot(pf.poses[:, 0] - 22.0, pf.poses[:, 1] - 9.0))
+    assert near.max() < 0.6
+    at_first = np.hypot(pf.poses[1000:, 0] - 8.0, pf.poses[1000:, 1] - 6.0) < 0.6
+    assert 0.5 < at_first.mean() < 0.7  # copies picked by weight: 600 of 1000
+    # One place: the original's reseed (the upper half's spread, floored).
+    pf.poses[:1000] = (8.0, 6.0, 0.0) + rng.normal(0.0, 0.3, (1000, 3))
+    pf.poses[1000:] = (15.0, 1.0, 0.0)
+    pf.weights[:] = np.where(np.arange(2000) < 1000, 1.0, 0.001)
+    pf.weights /= pf.weights.sum()
+    pf.reseed_worst_half(0.05, 0.05)
+    spread = np.hypot(pf.poses[1000:, 0] - 8.0, pf.poses[1000:, 1] - 6.0)
+    assert 0.3 < np.median(spread) < 0.8
