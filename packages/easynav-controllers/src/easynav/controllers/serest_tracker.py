@@ -30,6 +30,8 @@ TIP_ENTER = math.radians(60.0)
 TIP_EXIT = math.radians(35.0)
 NEAR_START_S = 0.30
 ALIGN_CRUISE = math.radians(30.0)
+#: Half the arc (m) over which the path's own curvature is measured (see :meth:`step`).
+CURVATURE_HALF_WINDOW = 0.15
 
 #: Phases reported in :attr:`SerestOutput.state`.
 TRACKING, TURN_IN_PLACE, FINAL_ALIGN, ARRIVED, EMERGENCY = (
@@ -151,6 +153,24 @@ class SerestTracker:
             kappa = 0.5 * (kappa + k2)
         return psi_ref, kappa
 
+    @staticmethod
+    def path_curvature(pts: np.ndarray, s_acc: np.ndarray, s_star: float, half: float) -> float:
+        """The path's mean curvature (1/m, signed) over ``[s_star - half, s_star + half]`` of
+        arc length (clipped to the path): its heading change there over that arc."""
+        last = len(pts) - 2
+        lo = min(max(s_star - half, 0.0), s_acc[-1])
+        hi = min(max(s_star + half, 0.0), s_acc[-1])
+        if last < 1 or hi - lo <= 1e-6:
+            return 0.0
+        first = min(max(int(np.searchsorted(s_acc, lo, side="right")) - 1, 0), last)
+        end = min(max(int(np.searchsorted(s_acc, hi, side="left")) - 1, 0), last)
+        if end <= first:
+            return 0.0
+        d = np.diff(pts[first:end + 2], axis=0)
+        headings = np.arctan2(d[:, 1], d[:, 0])
+        turn = float(np.sum(np.arctan2(np.sin(np.diff(headings)), np.cos(np.diff(headings)))))
+        return turn / (hi - lo)
+
     def v_safe(self, d: float) -> float:
         """The speed that stops ``d0_margin`` short of an obstacle ``d`` metres away."""
         p = self.params
@@ -192,6 +212,14 @@ class SerestTracker:
         s_acc = np.concatenate(([0.0], np.cumsum(np.hypot(*(np.diff(pts, axis=0).T)))))
         seg, closest, s_star = self.project(pts, s_acc, robot)
         psi_ref, kappa = self.reference(pts, s_acc, seg, s_star, self.last_v)
+        # The original's curvature blends the turns at the current segment's two vertices only:
+        # on a densely sampled path (a sampling planner's, a smoothed one), which turns a few
+        # degrees at each of many vertices, it sees a fraction of the turn (0.08 1/m where an
+        # OMPL path turned 97 degrees in 0.5 m), and the robot ran wide into a pillar. The
+        # path's own turn around the robot's projection is the floor.
+        own = self.path_curvature(pts, s_acc, s_star, CURVATURE_HALF_WINDOW)
+        if abs(own) > abs(kappa):
+            kappa = min(max(own, -p["kappa_max"]), p["kappa_max"])
         normal = np.array((-math.sin(psi_ref), math.cos(psi_ref)))
         e_y = float(np.dot(robot - closest, normal))
         e_theta = _wrap(yaw - psi_ref)
