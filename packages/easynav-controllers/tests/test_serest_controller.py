@@ -22,7 +22,7 @@ from closed_loop import (
 from easynav.common.sensors import PointPerception
 from easynav.controllers.obstacle_distance import RobotWay, closest_lethal_distance
 from easynav.controllers.serest_controller import SerestController
-from easynav.controllers.serest_tracker import SEREST_DEFAULTS, SerestTracker
+from easynav.controllers.serest_tracker import SEREST_DEFAULTS, TURN_PROBE_STEP, SerestTracker
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import PluginConfigurationError
 from easynav.core.robot import RobotLimits
@@ -370,3 +370,42 @@ def test_follows_a_densely_sampled_tight_turn_without_running_wide(start_yaw):
                     poses[:, None, 1] - pillars[None, :, 1])
     clearance = float(gaps.min()) - 0.025 - 0.15  # to the cells' edges, less the robot's radius
     assert clearance > 0.12, clearance
+
+
+def test_brakes_for_a_densely_sampled_right_angle_ahead():
+    # 3 m east then 3 m north, a pose every 5 cm, at up to 1 m/s: the curvature at the
+    # projection alone rises 0.15 m before the corner, too late to shed the speed (0.44 m past
+    # the corner; 0.55 m with the original's blend). The turn speed ahead brakes in time.
+    clock = Clock()
+    limits = RobotLimits(max_linear_vel=1.0, max_angular_vel=1.0)
+    serest = make({"v_ref": 1.0}, limits, clock)
+    east = np.column_stack((np.arange(0.0, 3.0, 0.05), np.zeros(60)))
+    north = np.column_stack((np.full(61, 3.0), np.arange(0.0, 3.001, 0.05)))
+    xy = np.vstack((east, north))
+    path = np.column_stack((xy, np.full(len(xy), 0.0)))
+    path[60:, 2] = math.pi / 2
+    nav_state = loop_state(path)
+    run = run_closed_loop(serest, nav_state, clock, dt=DT, t_max=30.0)
+    assert run.arrived
+    assert max(distance_to_path(path, x, y) for x, y, _ in run.poses) < 0.15
+    assert max(v for v, _ in run.commands) > 0.9  # full speed on the straight legs
+    steps = zip(run.poses, run.commands, strict=True)
+    speed_at_corner = min(v for (x, y, _), (v, _) in steps if math.hypot(x - 3.0, y) < 0.3)
+    assert speed_at_corner < 0.6
+
+
+def test_turn_speed_ahead_allows_braking_to_each_turn():
+    tracker = SerestTracker()
+    limits = RobotLimits(max_linear_vel=1.0, max_angular_vel=1.0, max_linear_decel=1.0)
+    corner = np.array([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)])
+    s_acc = np.array([0.0, 1.0, 2.0])
+    tracker.last_v = 1.0  # braking distance 0.5 m: the corner, 1 m ahead, is out of reach
+    assert tracker.turn_speed_ahead(corner, s_acc, 0.0, limits) == math.inf
+    # 0.5 m before it the window's edge reaches it (kappa 2.5 1/m capped: 0.4 m/s there).
+    near = tracker.turn_speed_ahead(corner, s_acc, 0.5, limits)
+    v_turn = min(1.0 / 2.5, math.sqrt(SEREST_DEFAULTS["a_lat_soft"] / 2.5))
+    assert v_turn < near < math.sqrt(v_turn ** 2 + 2.0 * 1.0 * 0.5)
+    # On the corner: the curvature there is the command's own business; the first point
+    # ahead (TURN_PROBE_STEP) still sees the capped curvature.
+    on = tracker.turn_speed_ahead(corner, s_acc, 1.0, limits)
+    assert on == pytest.approx(math.sqrt(v_turn ** 2 + 2.0 * 1.0 * TURN_PROBE_STEP))
