@@ -409,3 +409,13 @@ def test_turn_speed_ahead_allows_braking_to_each_turn():
     # ahead (TURN_PROBE_STEP) still sees the capped curvature.
     on = tracker.turn_speed_ahead(corner, s_acc, 1.0, limits)
     assert on == pytest.approx(math.sqrt(v_turn ** 2 + 2.0 * 1.0 * TURN_PROBE_STEP))
+
+
+def test_nearly_repeated_poses_do_not_turn_the_path():
+    # A pose 0.1 um before the corner: its heading from the previous one is noise (here a turn
+    # of -135 degrees, then +225), which read as a right turn of the capped curvature.
+    pts = SerestTracker._clean(np.array([(0.0, 0.0), (1.0, 0.0), (1.0 - 1e-7, -1e-7),
+                                         (1.0, 1.0)]), (0.0, 0.0))
+    s_acc = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))))
+    assert SerestTracker.path_curvature(pts, s_acc, 1.0, 0.15) == pytest.approx(
+        (math.pi / 2) / 0.3, rel=1e-3)

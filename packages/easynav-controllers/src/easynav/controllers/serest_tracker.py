@@ -34,6 +34,8 @@ ALIGN_CRUISE = math.radians(30.0)
 CURVATURE_HALF_WINDOW = 0.15
 #: Spacing (m) of the points ahead where :meth:`SerestTracker.turn_speed_ahead` looks.
 TURN_PROBE_STEP = 0.05
+#: Consecutive path poses closer than this (m) count as one.
+MIN_STEP = 1e-4
 
 #: Phases reported in :attr:`SerestOutput.state`.
 TRACKING, TURN_IN_PLACE, FINAL_ALIGN, ARRIVED, EMERGENCY = (
@@ -103,7 +105,9 @@ class SerestTracker:
         if len(pts) == 0:
             raise ValueError("SeReST: the path is empty")
         keep = np.ones(len(pts), dtype=bool)
-        keep[1:] = np.hypot(*(np.diff(pts, axis=0).T)) > 1e-9
+        # Poses closer than MIN_STEP are one: a heading between two nearly equal poses is noise
+        # (a turn of arbitrary sign, capped at kappa_max, in the path's curvature).
+        keep[1:] = np.hypot(*(np.diff(pts, axis=0).T)) > MIN_STEP
         pts = pts[keep]
         if len(pts) == 1:
             pts = np.vstack((np.asarray(position, dtype=float), pts))
