@@ -277,3 +277,42 @@ def test_reseed_keeps_each_copy_at_its_own_place():
     pf.reseed_worst_half(0.05, 0.05)
     spread = np.hypot(pf.poses[1000:, 0] - 8.0, pf.poses[1000:, 1] - 6.0)
     assert 0.3 < np.median(spread) < 0.8
+
+
+def test_estimate_with_equal_weights_weighs_every_place_by_its_particles():
+    # After a resample every weight is equal; the redrawn place sits at the low indices. The
+    # first half of the array held 60 % of this place with 30 % of the particles and the
+    # estimate went there; ties in the upper half count, so the larger place wins.
+    pf = filter_with(1000)
+    pf.poses[:300] = (22.0, 9.0, 0.0)
+    pf.poses[300:] = (8.0, 6.0, 0.0)
+    pf.weights[:] = 1.0 / 1000
+    assert pf.estimate() == pytest.approx((8.0, 6.0, 0.0))
+
+
+def test_a_sparse_cloud_along_a_corridor_is_one_place():
+    # 100 particles (the original's default count) spread 2 m along a corridor: the estimate
+    # stays on the whole upper half's mean, not on a fragment of it, whatever the weights.
+    rng = np.random.default_rng(0)
+    pf = filter_with(100)
+    pf.poses[:, :2] = rng.normal(0.0, (2.0, 0.1), (100, 2))
+    pf.poses[:, 2] = 0.0
+    off = []
+    for _ in range(200):
+        weights = rng.random(100)
+        pf.weights = weights / weights.sum()
+        top = np.argsort(-pf.weights)[:50]
+        mean = pf.weights[top] @ pf.poses[top, 0] / pf.weights[top].sum()
+        off.append(abs(pf.estimate()[0] - mean))
+    assert np.median(off) < 1e-9 and max(off) < 0.5
+
+
+def test_place_clusters_bridge_two_empty_cells_and_set_non_finite_apart():
+    # Two cells at every offset up to 4 cells: one place up to two empty cells between them.
+    for dx in range(-4, 5):
+        for dy in range(-4, 5):
+            if dx or dy:
+                xy = np.array([[5.1, 5.1], [5.1 + 0.5 * dx, 5.1 + 0.5 * dy]])
+                apart = max(abs(dx), abs(dy)) > 3
+                assert place_clusters(xy).tolist() == ([0, 1] if apart else [0, 0]), (dx, dy)
+    assert place_clusters(np.array([[0.0, 0.0], [np.nan, 1.0], [0.1, 0.0]])).tolist() == [0, 1, 0]
