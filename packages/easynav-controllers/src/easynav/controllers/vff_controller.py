@@ -271,8 +271,12 @@ class VffController(ControllerMethodBase):
             v = min(v, self._corner_speed(path_xy, pose, limits))
             if (self.vectors.repulsive == (0.0, 0.0) and path_xy is not None
                     and dist > self.params.look_ahead_dist):
+                # At the speed the robot will have this cycle (the acceleration limits it),
+                # not the one asked for: speeding up from a waypoint, the arc for the asked
+                # speed turned the robot faster than its path bends.
+                v_now, _ = limit_command(v, 0.0, *self._last, dt, limits, allow_reverse=False)
                 pursuit = pursuit_turn_rate(
-                    v, _wrap(bearing - pose[2]),
+                    v_now, _wrap(bearing - pose[2]),
                     math.hypot(carrot[0] - pose[0], carrot[1] - pose[1]))
                 if pursuit * w >= 0.0 and abs(pursuit) > abs(w):
                     w = min(max(pursuit, -limits.max_angular_vel), limits.max_angular_vel)
