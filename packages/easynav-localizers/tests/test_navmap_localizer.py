@@ -519,3 +519,24 @@ def test_over_ros_odom_initialpose_tf_and_particles_with_height(ros):
     heights = [p.position.z for p in particles[-1].poses]
     assert len(heights) == 50 and np.allclose(heights, 1.5)
     amcl.cleanup()
+
+
+def test_the_estimate_takes_the_height_of_its_own_place():
+    # Most weight on the upper level at (9, 4), a few heavier single particles on the ground at
+    # (2, 4): the estimate is the heaviest place's, and so is its height (the best particle
+    # overall stood on the ground, 1.5 m below).
+    sim = Sim({"num_particles": 100, "initial_pose.x": 9.0, "initial_pose.y": 4.0,
+               "initial_pose.z": 1.5, "initial_pose.std_dev_xy": 0.05})
+    amcl = sim.amcl
+    sim.move(0.0)
+    with amcl._lock:
+        amcl.filter.poses[:10, :2] = (2.0, 4.0)
+        amcl._z[:10] = 0.0
+        amcl._z[10:] = 1.5
+        amcl._on_mesh[:] = True
+        amcl.filter.weights[:10] = 0.04
+        amcl.filter.weights[10:] = 0.6 / 90
+        estimate = amcl.filter.estimate()
+        assert math.hypot(estimate[0] - 9.0, estimate[1] - 4.0) < 0.2
+        assert amcl._best_z() == 0.0
+        assert amcl._best_z(estimate) == 1.5

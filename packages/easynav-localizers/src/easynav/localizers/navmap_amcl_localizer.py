@@ -46,6 +46,8 @@ IMU_KEY = NavStateKey(
 #: A particle is on the mesh when a NavCel's surface lies within this height of its predicted z
 #: (the original's ``height_eps``); otherwise it is off the mesh (see the class docstring).
 SNAP_HEIGHT_EPS = 0.5
+#: The estimate's height comes from the best particle within this distance (m) of it.
+Z_PLACE_RADIUS = 1.0
 #: Weight of a particle off the mesh, and floor of the others (the original's 1e-6).
 WEIGHT_FLOOR = 1e-6
 #: inflation_stddev when the value given is not > 0 (the original's fallback).
@@ -445,7 +447,7 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
             estimate = self.filter.estimate()
             covariance = self.filter.covariance(estimate)
             poses = self.filter.poses.copy()
-            self._level_hint = self._best_z()
+            self._level_hint = self._best_z(estimate)
             z = self._z.copy()
         self._write_pose(nav_state, estimate, covariance, self._odom)
         self._publish_particles(poses, estimate, covariance, z)
@@ -550,9 +552,18 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
         f.unweighed = None
         self._generation += 1  # hits and possible restart with the new cloud
 
-    def _best_z(self) -> float:
-        """Height of the best particle on the mesh (NaN when none is). Lock held."""
-        weights = np.where(self._on_mesh & np.isfinite(self._z), self.filter.weights, -1.0)
+    def _best_z(self, estimate: tuple[float, float, float] | None = None) -> float:
+        """Height of the best particle on the mesh (NaN when none is), among those within
+        :data:`Z_PLACE_RADIUS` of ``estimate`` when any is: the estimate is the heaviest place's
+        (``ParticleFilter2D.estimate``), and the best particle overall may stand elsewhere, on
+        another floor. Lock held."""
+        usable = self._on_mesh & np.isfinite(self._z)
+        if estimate is not None:
+            near = usable & (np.hypot(self.filter.poses[:, 0] - estimate[0],
+                                      self.filter.poses[:, 1] - estimate[1]) <= Z_PLACE_RADIUS)
+            if near.any():
+                usable = near
+        weights = np.where(usable, self.filter.weights, -1.0)
         best = int(np.argmax(weights))
         return float(self._z[best]) if weights[best] >= 0.0 else math.nan
 
@@ -568,7 +579,7 @@ class NavMapAMCLLocalizer(AMCLLocalizer):
         particle's level (the hint's height when the mesh is not under it)."""
         x, y, yaw = estimate
         with self._lock:
-            hint = self._best_z()
+            hint = self._best_z(estimate)
             if not math.isfinite(hint):
                 hint = self._level_hint
             z_all, w = self._z.copy(), self.filter.weights.copy()
