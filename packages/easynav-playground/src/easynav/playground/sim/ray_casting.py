@@ -1,9 +1,12 @@
-"""Vectorised ray casting against an occupancy grid and against discs.
+"""Ray casting against an occupancy grid and against discs.
 
 Written by hand: no maintained Python library ray-casts a numpy occupancy grid exactly (the
-usual helpers march in fixed steps and miss cell corners). The grid caster enumerates every
-grid-line crossing of every ray at once (an exact Amanatides–Woo traversal done as one sort),
-so there is no Python loop over beams or cells.
+usual helpers march in fixed steps and miss cell corners). :func:`cast_rays_grid` runs a
+compiled Amanatides–Woo traversal per ray (numba) when numba is installed, else
+:func:`cast_rays_grid_reference`, which enumerates every grid-line crossing of every ray at once
+(the same traversal done as one sort, no Python loop over beams or cells) and is the compiled
+one's reference in the tests. Measured on the depot (604 × 307 cells, 360 beams, 12 m):
+28 ms a scan in numpy, a playground at twice real time spending half a core on it.
 """
 
 from __future__ import annotations
@@ -12,8 +15,47 @@ import numpy as np
 
 from easynav.playground.sim.world import World
 
+_kernel = None  # None: not tried yet; False: numba is not installed
+
+
+def _compiled_caster():
+    """The compiled caster (:mod:`~easynav.playground.sim.ray_casting_kernel`), or None
+    without numba."""
+    global _kernel
+    if _kernel is None:
+        try:
+            from easynav.common.compiled_kernels import compile_in_child
+            from easynav.playground.sim import ray_casting_kernel
+
+            _kernel = compile_in_child(
+                ray_casting_kernel.cast_rays_grid_cells,
+                "easynav.playground.sim.ray_casting_kernel:cast_rays_grid_cells",
+            )
+        except ImportError:
+            _kernel = False
+    return _kernel or None
+
 
 def cast_rays_grid(
+    world: World, origin_x: float, origin_y: float, angles: np.ndarray, max_range: float
+) -> np.ndarray:
+    """Distance (m) along each ray to the first occupied cell, ``inf`` when none within range
+    (see :func:`cast_rays_grid_reference`, which it equals); compiled when numba is
+    installed."""
+    kernel = _compiled_caster()
+    if kernel is None:
+        return cast_rays_grid_reference(world, origin_x, origin_y, angles, max_range)
+    angles = np.asarray(angles, dtype=float)
+    res = world.resolution
+    occupied = world.occupied
+    if occupied.dtype != np.bool_ or not occupied.flags.c_contiguous:
+        occupied = np.ascontiguousarray(occupied, dtype=np.bool_)
+    cells = kernel(occupied, (origin_x - world.origin_x) / res, (origin_y - world.origin_y) / res,
+                   np.cos(angles).ravel(), np.sin(angles).ravel(), max_range / res)
+    return (cells * res).reshape(angles.shape)
+
+
+def cast_rays_grid_reference(
     world: World, origin_x: float, origin_y: float, angles: np.ndarray, max_range: float
 ) -> np.ndarray:
     """Distance (m) along each ray to the first occupied cell, ``inf`` when none within range.
