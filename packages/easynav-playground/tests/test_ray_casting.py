@@ -126,3 +126,23 @@ def test_a_ray_backwards_from_a_grid_line_starts_in_the_cell_behind_it(cast):
     world = World(grid, 1.0)
     assert cast(world, 5.0, 0.5, np.array([math.pi]), 20.0)[0] == 0.0
     assert cast(world, 5.0, 0.5, np.array([0.0]), 20.0)[0] == np.inf
+
+
+@GRID_CASTERS
+def test_non_finite_origins_and_angles_hit_nothing(cast):
+    # The compiled traversal looped for ever on a NaN or infinite origin (no crossing ends it).
+    grid = np.zeros((10, 10), dtype=bool)
+    grid[5, 5] = True
+    world = World(grid, 0.1)
+    for x, y in ((math.nan, 0.55), (math.inf, 0.55), (-math.inf, 0.55), (0.55, math.inf)):
+        assert np.all(np.isinf(cast(world, x, y, np.array([0.0, math.pi, 1.0]), 5.0)))
+    assert cast(world, -3.0, 0.55, np.array([0.0, math.nan]), 10.0)[1] == np.inf
+
+
+def test_bad_max_range_or_angles_are_refused():
+    world = World(np.zeros((10, 10), dtype=bool), 0.1)
+    for bad in (0.0, -1.0, math.nan, math.inf):
+        with pytest.raises(ValueError, match="max_range"):
+            cast_rays_grid(world, 0.5, 0.5, np.array([0.0]), bad)
+    with pytest.raises(ValueError, match="1-D"):
+        cast_rays_grid(world, 0.5, 0.5, np.zeros((2, 3)), 1.0)

@@ -11,28 +11,39 @@ one's reference in the tests. Measured on the depot (604 × 307 cells, 360 beams
 
 from __future__ import annotations
 
+import logging
+import math
+import threading
+
 import numpy as np
 
 from easynav.playground.sim.world import World
 
-_kernel = None  # None: not tried yet; False: numba is not installed
+_LOG = logging.getLogger("easynav.playground.ray_casting")
+
+_kernel = None  # None: not tried yet; False: unavailable
+_kernel_lock = threading.Lock()
 
 
 def _compiled_caster():
     """The compiled caster (:mod:`~easynav.playground.sim.ray_casting_kernel`), or None
-    without numba."""
+    without numba (or when numba cannot load it: no writable cache, for one)."""
     global _kernel
     if _kernel is None:
-        try:
-            from easynav.common.compiled_kernels import compile_in_child
-            from easynav.playground.sim import ray_casting_kernel
+        with _kernel_lock:
+            if _kernel is None:
+                try:
+                    from easynav.common.compiled_kernels import compile_in_child
+                    from easynav.playground.sim import ray_casting_kernel
 
-            _kernel = compile_in_child(
-                ray_casting_kernel.cast_rays_grid_cells,
-                "easynav.playground.sim.ray_casting_kernel:cast_rays_grid_cells",
-            )
-        except ImportError:
-            _kernel = False
+                    _kernel = compile_in_child(
+                        ray_casting_kernel.cast_rays_grid_cells,
+                        "easynav.playground.sim.ray_casting_kernel:cast_rays_grid_cells",
+                    )
+                except Exception as exc:  # noqa: BLE001 - any failure: the numpy caster runs
+                    if not isinstance(exc, ImportError):
+                        _LOG.warning("compiled ray casting unavailable (%s); using numpy", exc)
+                    _kernel = False
     return _kernel or None
 
 
@@ -41,18 +52,27 @@ def cast_rays_grid(
 ) -> np.ndarray:
     """Distance (m) along each ray to the first occupied cell, ``inf`` when none within range
     (see :func:`cast_rays_grid_reference`, which it equals); compiled when numba is
-    installed."""
+    installed.
+
+    Raises:
+        ValueError: ``max_range`` not finite and > 0, or ``angles`` not one-dimensional.
+    """
+    angles = np.asarray(angles, dtype=float)
+    if angles.ndim != 1:
+        raise ValueError(f"angles must be a 1-D array, got shape {angles.shape}")
+    if not (math.isfinite(max_range) and max_range > 0.0):
+        raise ValueError(f"max_range = {max_range} must be finite and > 0")
     kernel = _compiled_caster()
     if kernel is None:
         return cast_rays_grid_reference(world, origin_x, origin_y, angles, max_range)
-    angles = np.asarray(angles, dtype=float)
     res = world.resolution
     occupied = world.occupied
     if occupied.dtype != np.bool_ or not occupied.flags.c_contiguous:
         occupied = np.ascontiguousarray(occupied, dtype=np.bool_)
-    cells = kernel(occupied, (origin_x - world.origin_x) / res, (origin_y - world.origin_y) / res,
-                   np.cos(angles).ravel(), np.sin(angles).ravel(), max_range / res)
-    return (cells * res).reshape(angles.shape)
+    cells = kernel(occupied, float((origin_x - world.origin_x) / res),
+                   float((origin_y - world.origin_y) / res), np.cos(angles), np.sin(angles),
+                   float(max_range / res))
+    return cells * res
 
 
 def cast_rays_grid_reference(
@@ -89,8 +109,9 @@ def cast_rays_grid_reference(
     # A segment between consecutive crossings lies in exactly one cell: sample its midpoint.
     valid = t_end > t_start
     mid = np.where(valid, 0.5 * (t_start + t_end), 0.0)  # inf segments: any finite value
-    cx = np.floor(gx + mid * dx[:, None]).astype(np.int64)
-    cy = np.floor(gy + mid * dy[:, None]).astype(np.int64)
+    with np.errstate(invalid="ignore"):  # a non-finite origin or angle: no valid segment
+        cx = np.floor(gx + mid * dx[:, None]).astype(np.int64)
+        cy = np.floor(gy + mid * dy[:, None]).astype(np.int64)
     inside = valid & (cx >= 0) & (cy >= 0) & (cx < width) & (cy < height)
     hit = np.zeros(t_start.shape, dtype=bool)
     hit[inside] = world.occupied[cy[inside], cx[inside]]

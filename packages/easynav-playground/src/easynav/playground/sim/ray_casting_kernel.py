@@ -17,6 +17,22 @@ from numba import njit
 
 @njit(cache=True, nogil=True)
 def _first_hit(occupied, width, height, gx, gy, dx, dy, reach):  # pragma: no cover - compiled
+    if not (math.isfinite(gx) and math.isfinite(gy) and math.isfinite(dx) and math.isfinite(dy)):
+        return math.inf  # as the reference: no crossing is finite, nothing is hit
+    # A ray that misses the grid's box, or reaches it beyond the range, hits nothing: without
+    # this a ray from far outside would walk every cell on its way (slab test).
+    t_in, t_out = 0.0, reach
+    for g, d, size in ((gx, dx, width), (gy, dy, height)):
+        if d == 0.0:
+            if g < 0.0 or g > size:
+                return math.inf
+        else:
+            t0, t1 = (0.0 - g) / d, (size - g) / d
+            if t0 > t1:
+                t0, t1 = t1, t0
+            t_in, t_out = max(t_in, t0), min(t_out, t1)
+    if t_in > t_out or t_in >= reach:
+        return math.inf
     if dx > 0.0:
         step_x, cx = 1, int(math.floor(gx))
     elif dx < 0.0:
