@@ -207,16 +207,21 @@ def place_clusters(xy: np.ndarray, cell: float = PLACE_CELL) -> np.ndarray:
     redraw finds are metres apart."""
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     labels = np.zeros(len(xy), dtype=np.intp)
+    if len(xy) == 0:
+        return labels
+    low = xy.min(axis=0)
+    span = xy.max(axis=0) - low
+    if np.all(span < 3.0 * cell):
+        # Every position within three cells of every other (finite ones: NaN fails the test):
+        # one place, whatever is between them. A compact cloud, the usual case, estimated
+        # every RT cycle: no grid to label.
+        return labels
     finite = np.isfinite(xy).all(axis=1)
     if not finite.all():
         labels[finite] = place_clusters(xy[finite], cell)
         count = int(labels[finite].max()) + 1 if finite.any() else 0
         labels[~finite] = count + np.arange(int((~finite).sum()))
         return labels
-    if len(xy) == 0:
-        return labels
-    low = xy.min(axis=0)
-    span = xy.max(axis=0) - low
     while (span[0] / cell + 3.0) * (span[1] / cell + 3.0) > _PLACE_GRID_MAX_CELLS:
         cell *= 2.0
     cells = np.floor((xy - low) / cell).astype(np.intp) + 1  # a cell of margin for the bridge
