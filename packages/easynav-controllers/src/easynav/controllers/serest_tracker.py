@@ -209,18 +209,26 @@ class SerestTracker:
         :data:`CURVATURE_HALF_WINDOW`) ahead of ``s_star``; inf when none is that close. The
         curvature at the projection alone left a robot at 1 m/s 0.15 m to shed its speed
         before a densely sampled right angle: it overshot by 0.44 m."""
-        p = self.params
+        probes = self._turn_probes(s_acc, s_star, limits)
+        curvatures = self.path_curvatures(pts, s_acc, probes, CURVATURE_HALF_WINDOW)
+        return self._speed_before_turns(probes, curvatures, s_star, limits)
+
+    def _turn_probes(self, s_acc: np.ndarray, s_star: float, limits: RobotLimits) -> np.ndarray:
+        """Arc lengths ahead of ``s_star`` where :meth:`turn_speed_ahead` looks."""
         decel = max(0.1, limits.max_linear_decel)
         reach = self.last_v ** 2 / (2.0 * decel) + CURVATURE_HALF_WINDOW
         probes = s_star + np.arange(TURN_PROBE_STEP, reach + 1e-9, TURN_PROBE_STEP)
-        probes = probes[probes < s_acc[-1]]
-        if len(probes) == 0:
-            return math.inf
-        curv = np.abs(self.path_curvatures(pts, s_acc, probes, CURVATURE_HALF_WINDOW))
-        curv = np.minimum(curv, p["kappa_max"])
+        return probes[probes < s_acc[-1]]
+
+    def _speed_before_turns(self, probes: np.ndarray, curvatures: np.ndarray, s_star: float,
+                            limits: RobotLimits) -> float:
+        """:meth:`turn_speed_ahead` from the path's curvatures at ``probes``."""
+        p = self.params
+        curv = np.minimum(np.abs(curvatures), p["kappa_max"])
         tight = curv > 1e-6
         if not tight.any():
             return math.inf
+        decel = max(0.1, limits.max_linear_decel)
         v_turn = np.minimum(limits.max_angular_vel / curv[tight],
                             np.sqrt(p["a_lat_soft"] / curv[tight]))
         return float(np.min(np.sqrt(v_turn ** 2 + 2.0 * decel * (probes[tight] - s_star))))
@@ -271,7 +279,11 @@ class SerestTracker:
         # degrees at each of many vertices, it sees a fraction of the turn (0.08 1/m where an
         # OMPL path turned 97 degrees in 0.5 m), and the robot ran wide into a pillar. The
         # path's own turn around the robot's projection is the floor.
-        own = self.path_curvature(pts, s_acc, s_star, CURVATURE_HALF_WINDOW)
+        # One computation for the projection and the turns ahead (turn_speed_ahead's probes).
+        probes = self._turn_probes(s_acc, s_star, limits)
+        curvatures = self.path_curvatures(pts, s_acc, np.concatenate(([s_star], probes)),
+                                          CURVATURE_HALF_WINDOW)
+        own = float(curvatures[0])
         if abs(own) > abs(kappa):
             kappa = min(max(own, -p["kappa_max"]), p["kappa_max"])
         normal = np.array((-math.sin(psi_ref), math.cos(psi_ref)))
@@ -302,7 +314,7 @@ class SerestTracker:
         if ak > 1e-6:
             v_curv = min(max_v, max_w / ak, math.sqrt(p["a_lat_soft"] / ak))
         if not homing:
-            v_curv = min(v_curv, self.turn_speed_ahead(pts, s_acc, s_star, limits))
+            v_curv = min(v_curv, self._speed_before_turns(probes, curvatures[1:], s_star, limits))
 
         debug = {
             "e_y": e_y, "e_theta": e_theta, "kappa_hat": kappa, "d_closest": d_closest,
