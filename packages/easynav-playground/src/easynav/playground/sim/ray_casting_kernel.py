@@ -16,6 +16,20 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _axis_start(g, d):  # pragma: no cover - compiled
+    """Along one axis: the step (+1, -1, 0), the ray's first cell and the next grid line. A
+    ray going backwards from a grid line starts in the cell behind it."""
+    if d > 0.0:
+        cell = int(math.floor(g))
+        return 1, cell, float(cell + 1)
+    if d < 0.0:
+        cell = int(math.ceil(g)) - 1
+        return -1, cell, float(cell)
+    cell = int(math.floor(g))
+    return 0, cell, float(cell)
+
+
+@njit(cache=True, nogil=True)
 def _first_hit(occupied, width, height, gx, gy, dx, dy, reach):  # pragma: no cover - compiled
     if not (math.isfinite(gx) and math.isfinite(gy) and math.isfinite(dx) and math.isfinite(dy)):
         return math.inf  # as the reference: no crossing is finite, nothing is hit
@@ -33,22 +47,10 @@ def _first_hit(occupied, width, height, gx, gy, dx, dy, reach):  # pragma: no co
             t_in, t_out = max(t_in, t0), min(t_out, t1)
     if t_in > t_out or t_in >= reach:
         return math.inf
-    if dx > 0.0:
-        step_x, cx = 1, int(math.floor(gx))
-    elif dx < 0.0:
-        step_x, cx = -1, int(math.ceil(gx)) - 1
-    else:
-        step_x, cx = 0, int(math.floor(gx))
-    if dy > 0.0:
-        step_y, cy = 1, int(math.floor(gy))
-    elif dy < 0.0:
-        step_y, cy = -1, int(math.ceil(gy)) - 1
-    else:
-        step_y, cy = 0, int(math.floor(gy))
-    # The next grid line each way, and the ray parameter where the ray crosses it (computed
-    # from the line, not accumulated: the same arithmetic as the reference's crossings).
-    line_x = float(cx + 1) if step_x > 0 else float(cx)
-    line_y = float(cy + 1) if step_y > 0 else float(cy)
+    step_x, cx, line_x = _axis_start(gx, dx)
+    step_y, cy, line_y = _axis_start(gy, dy)
+    # The ray parameter where the ray crosses the next grid line each way (computed from the
+    # line, not accumulated: the same arithmetic as the reference's crossings).
     t_x = (line_x - gx) / dx if step_x != 0 else math.inf
     t_y = (line_y - gy) / dy if step_y != 0 else math.inf
     t = 0.0
