@@ -89,6 +89,7 @@ def test_switching_amcl_to_fusion_mid_mission_continues_from_the_last_pose(tmp_p
                 [("localizer_node", "simple.plugin", FUSION)], "scenario: AMCL to fusion"
             )
             run.spin_until(lambda: _active_with(rt, "FusionLocalizer"), 30.0, "FusionLocalizer")
+            fusion_at = run.sim_time()
             assert run.client.get_state() is GoalClientState.ACCEPTED_AND_NAVIGATING
             state, message = run.wait_for_end(timeout=150.0)
             ended_at = run.sim_time()
@@ -98,17 +99,19 @@ def test_switching_amcl_to_fusion_mid_mission_continues_from_the_last_pose(tmp_p
     assert state == "NAVIGATION_FINISHED", (state, message)
     assert run.truth.distance_driven(swap_at, ended_at) > 3.0  # most of the mission on fusion
     assert run.truth.collisions == []
-    # Continuity: right after the switch the estimate is where AMCL left it: AMCL's own error
-    # (below 0.2 m in the home world, as the demo checks) plus what the robot moved while
-    # EasyNav reconfigured, braking (< 0.1 m). Had the fusion localizer started from its own
-    # origin, the error would be the start's distance from (0, 0), 6.5 m.
-    handed_over = run.truth.localisation_errors(swap_at, swap_at + 2.0)
-    assert handed_over.size > 5 and float(handed_over.max()) < 0.3, float(handed_over.max())
+    # Continuity: around the switch and in the fusion localizer's first 2 s the estimate stays
+    # on the robot: AMCL's own error (below 0.2 m in the home world, as the demo checks). The
+    # reconfiguration takes 1-2 s of simulated time (more on a loaded machine), and the robot
+    # may drive on meanwhile: the pose AMCL left is carried to the fusion localizer's first
+    # measurement by the odometry in between. Taken as it was, the estimate started up to
+    # 0.25 m behind the robot (measured; 0.01-0.07 m now). Had the fusion localizer started
+    # from its own origin instead, the error would be the start's distance from (0, 0), 6.5 m.
+    handed_over = run.truth.localisation_errors(swap_at, fusion_at + 2.0)
+    assert handed_over.size > 5 and float(handed_over.max()) < 0.2, float(handed_over.max())
     # Then wheels and IMU alone: dead reckoning drifts with the distance (the playground's wheels
-    # slip; measured 0.1-0.3 m over the ~5 m after the switch, more on a loaded machine whose
-    # late messages the filter integrates late). Bound: 0.5 m, still an order of magnitude below
-    # a restart's error; the robot ends within the goal tolerance (0.15 m) of where its estimate
-    # says the goal is.
+    # slip; measured 0.03-0.16 m over the ~5 m after the switch beside two busy processes,
+    # 0.24 m beside four). Bound: 0.5 m, an order of magnitude below a restart's error; the
+    # robot ends within the goal tolerance (0.15 m) of where its estimate says the goal is.
     after = run.truth.localisation_errors(swap_at, ended_at)
     assert after.size > 50 and float(after.max()) < 0.5, float(after.max())
     final = run.true_poses_between(ended_at - 1.0, ended_at)[-1]

@@ -348,6 +348,96 @@ def test_map_to_odom_when_the_odometry_transform_lags_the_estimate():
     assert math.hypot(*(without.transform.translation[:2] - (5.0, 3.0))) > 0.35
 
 
+def _turning_odometry(buffer, until: float, start: float = 0.0) -> None:
+    """odom -> robot every 0.02 s over [start, until]: 0.5 m/s forward, turning at 0.3 rad/s
+    from the odom origin, as (x, y, yaw) of t: exact arcs."""
+    for k in range(round(start / 0.02), round(until / 0.02) + 1):
+        buffer.set_transform_values("odom", "base_footprint", k * 0.02,
+                                    (*_arc(k * 0.02)[:2], 0.0,
+                                     *yaw_to_quaternion(_arc(k * 0.02)[2])), "test")
+
+
+def _arc(t: float) -> tuple[float, float, float]:
+    v, w = 0.5, 0.3
+    return v / w * math.sin(w * t), v / w * (1.0 - math.cos(w * t)), w * t
+
+
+def test_carry_pose_moves_a_pose_by_the_odometry_since_its_stamp():
+    """A pose of t = 1 carried to t = 2.5 by the odom -> robot transforms in between lands
+    where the robot is then; without transforms, the twist moves it (constant velocity), and
+    without either it stays. Map and odom differ by a rotation and a shift."""
+    from easynav.common.tf import TFBuffer
+    from easynav.localizers.map_to_odom import carry_pose
+
+    buffer = TFBuffer()
+    _turning_odometry(buffer, 3.0)
+    shift, turn = np.array((4.0, -2.0)), 0.7  # map -> odom
+
+    def in_map(pose):
+        c, s = math.cos(turn), math.sin(turn)
+        return (shift[0] + c * pose[0] - s * pose[1], shift[1] + s * pose[0] + c * pose[1],
+                pose[2] + turn)
+
+    then, now = in_map(_arc(1.0)), in_map(_arc(2.5))
+    carried = carry_pose(buffer, *then, 1.0, 2.5)
+    np.testing.assert_allclose(carried, now, atol=1e-6)
+    # Beyond the newest transform (t = 3): odometry to 3, then the twist for the rest.
+    later = in_map(_arc(3.4))
+    carried = carry_pose(buffer, *then, 1.0, 3.4, twist=(0.5, 0.0, 0.3))
+    np.testing.assert_allclose(carried[:2], later[:2], atol=2e-3)
+    # No odometry transforms: the twist alone (the arc's chord at the middle heading).
+    empty = TFBuffer()
+    carried = carry_pose(empty, *then, 1.0, 2.5, twist=(0.5, 0.0, 0.3))
+    np.testing.assert_allclose(carried, now, atol=1e-2)  # chord vs arc: 6 mm
+    assert carry_pose(empty, *then, 1.0, 2.5) == then
+    # Unstamped (0) or not older than ``until``: unchanged.
+    assert carry_pose(buffer, *then, 0.0, 2.5) == then
+    assert carry_pose(buffer, *then, 2.5, 2.5) == then
+
+
+def test_a_handed_over_pose_is_carried_to_the_first_measurement():
+    """A localizer swap: the previous localizer's last pose is stamped when it last ran
+    (t = 1.0); the fusion localizer starts fusing 1.5 s later, with odometry messages from
+    t = 2.5 only (the older ones fell out of its queue during the reconfiguration), while
+    the robot drove on. The estimate starts where the robot is at t = 2.5, not where it was
+    at t = 1.0 (0.75 m behind, for the rest of a mission on odometry alone)."""
+    from easynav.common.tf import get_tf_buffer
+
+    params = {
+        "Ukf.global_filter.two_d_mode": True,
+        "Ukf.global_filter.publish_tf": True,
+        "Ukf.global_filter.odom0": "odom",
+        "Ukf.global_filter.odom0_config": [False] * 6 + [True, False, False,
+                                                         False, False, True] + [False] * 3,
+    }
+    namespace = f"fusion_handover_{next(_namespaces)}"
+    clock = {"t": 1.0}
+    plugin = FusionLocalizer()
+    plugin.initialize(PluginContext(parameters=DictParameters(params), namespace=namespace,
+                                    now=lambda: clock["t"]), "Ukf")
+    buffer = get_tf_buffer(namespace)
+    _turning_odometry(buffer, 2.5)
+    # Map and odom coincide: the previous localizer's pose at t = 1 is the arc's.
+    x, y, yaw = _arc(1.0)
+    plugin.on_last_known_pose(Odometry(
+        header=Header(1.0, "map"), pose=Pose.from_xy_yaw(x, y, yaw),
+        pose_covariance=np.eye(6) * 1e-4, twist=Twist(vx=0.5, wz=0.3)))
+    nav_state = NavState()
+    for k in range(125, 151):  # t = 2.5 .. 3.0: odometry messages and transforms
+        t = k * 0.02
+        clock["t"] = t
+        _turning_odometry(buffer, t, start=t)
+        plugin.add_odometry("global_filter", "odom0", Odometry(
+            header=Header(t, "odom"), twist=Twist(vx=0.5, wz=0.3),
+            twist_covariance=np.eye(6) * 1e-6))
+        plugin.update_rt(nav_state)
+    estimate = nav_state.get("robot_pose", Odometry)
+    assert estimate.header.stamp == pytest.approx(3.0)
+    truth = _arc(3.0)
+    assert math.hypot(estimate.pose.x - truth[0], estimate.pose.y - truth[1]) < 0.01
+    assert abs(estimate.pose.yaw - truth[2]) < 0.01
+
+
 def test_a_late_fix_does_not_pull_the_estimate_back():
     """A fix that arrives after odometry has carried the estimate past its stamp (the sensors
     node runs apart from the RT loop) is where the robot *was*: moved on by the estimated

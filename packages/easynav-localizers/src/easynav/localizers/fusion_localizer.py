@@ -39,7 +39,7 @@ from easynav.localizers.fusion.ukf_filter import (
     UkfFilter,
     square_matrix,
 )
-from easynav.localizers.map_to_odom import map_to_odom
+from easynav.localizers.map_to_odom import carry_pose, map_to_odom
 
 #: NavState keys.
 ROBOT_POSE_LOCAL = NavStateKey(
@@ -141,6 +141,8 @@ class FusionLocalizer(LocalizerMethodBase):
         self._publish_tf = False
         self._predict_now: dict[str, bool] = {}
         self._gravity: dict[str, float] = {}
+        #: The pose handed over (``on_last_known_pose``), applied on the next cycle.
+        self._handover: Odometry | None = None
 
     # -- parameters ----------------------------------------------------------------------------
     @classmethod
@@ -223,6 +225,7 @@ class FusionLocalizer(LocalizerMethodBase):
             self._queues = queues
             self._gnss_stamps = {}
             self._projection = projection
+            self._handover = None
         self._publish_tf = "global_filter" in filters and v["global_filter.publish_tf"]
         if self.context.node is not None:
             self._create_ros()
@@ -253,16 +256,41 @@ class FusionLocalizer(LocalizerMethodBase):
 
     def on_last_known_pose(self, pose: Odometry) -> None:
         """Continue from ``pose`` (map frame): the global filter jumps there (GNSS shifted to
-        agree), the local filter keeps its odom-frame estimate."""
-        cov = np.asarray(pose.pose_covariance, dtype=float).reshape(6, 6)
+        agree), the local filter keeps its odom-frame estimate. The jump waits for the next
+        cycle with measurements: the pose is first carried by the odometry from its stamp to
+        the first of them (:func:`carry_pose`), since the robot may have driven on in between
+        (a reconfiguration takes a second or more)."""
         with self._lock:
-            target = self.filters.get("global_filter")
-            if target is not None:
-                target.reset_pose(pose.pose.x, pose.pose.y, pose.pose.yaw, cov)
+            self._handover = pose
         self.logger.info(
             f"{self.plugin_name}: continuing from ({pose.pose.x:.3f}, {pose.pose.y:.3f}, "
-            f"{pose.pose.yaw:.3f})"
+            f"{pose.pose.yaw:.3f}) at t={pose.header.stamp:.3f}"
         )
+
+    def _take_over(self, filt: FusionFilter, events: list, buffer) -> list:
+        """Apply the pending handover to the global filter ``filt`` before ``events`` (sorted)
+        are fused; returns the events left to fuse (those older than the pose describe motion
+        it already includes). Without events (and no filter time) it waits. Under the lock."""
+        pose = self._handover
+        stamp = pose.header.stamp
+        if events:
+            until = max(stamp, events[0][0])
+            events = [e for e in events if e[0] >= until]
+        elif filt.time is not None:
+            until = max(stamp, filt.time)
+        else:
+            return events
+        self._handover = None
+        twist = (pose.twist.vx, pose.twist.vy, pose.twist.wz)
+        x, y, yaw = carry_pose(buffer, pose.pose.x, pose.pose.y, pose.pose.yaw, stamp, until,
+                               twist)
+        if stamp > 0.0 and until > stamp:
+            self.logger.info(
+                f"{self.plugin_name}: the pose of t={stamp:.3f} carried to t={until:.3f}: "
+                f"({x:.3f}, {y:.3f}, {yaw:.3f})")
+        cov = np.asarray(pose.pose_covariance, dtype=float).reshape(6, 6)
+        filt.reset_pose(x, y, yaw, cov, time=until, twist=twist)
+        return events
 
     # -- cycle ---------------------------------------------------------------------------------
     def update(self, nav_state: NavState) -> None:
@@ -293,6 +321,8 @@ class FusionLocalizer(LocalizerMethodBase):
                         self._gnss_stamps[key] = fix.stamp
                         events.append((fix.stamp, name, fix))
                 events.sort(key=lambda e: e[0])
+                if prefix == "global_filter" and self._handover is not None:
+                    events = self._take_over(filt, events, buffer)
                 for _, name, value in events:
                     try:
                         if isinstance(value, Odometry):
