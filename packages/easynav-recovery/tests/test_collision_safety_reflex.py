@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from recovery_harness import RecordingActions, make_context, scan
+from recovery_harness import Clock, RecordingActions, make_context, scan
 
 from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
@@ -16,10 +16,11 @@ from easynav.recovery.diagnostic.reflexes.collision_safety_reflex import first_c
 ALIAS = "recovery_manager.collision"
 
 
-def make_reflex(params=None):
+def make_reflex(params=None, clock=None):
     nav_state = NavState()
     actions = RecordingActions(nav_state)
-    context = make_context({f"{ALIAS}.{k}": v for k, v in (params or {}).items()}, None, actions)
+    context = make_context({f"{ALIAS}.{k}": v for k, v in (params or {}).items()}, clock,
+                           actions)
     reflex = CollisionSafetyReflex()
     reflex.initialize(context, ALIAS)
     return reflex, nav_state, actions
@@ -104,6 +105,64 @@ def test_fuses_perceptions_of_other_frames():
     get_tf_buffer(reflex.context.namespace).set_transform(ts, "test", is_static=True)
     nav_state.set("laser1", scan([(0.4, 0.0, 0.0)], frame="laser"))  # 0.6 m ahead
     assert reflex.check_and_mitigate(nav_state, Twist(vx=0.5))
+
+
+def _odometry(reflex, samples) -> None:
+    """odom -> base_footprint transforms ``(stamp, x, y, yaw)``."""
+    from easynav.core.types import yaw_to_quaternion
+
+    buffer = get_tf_buffer(reflex.context.namespace)
+    for stamp, x, y, yaw in samples:
+        buffer.set_transform_values("odom", "base_footprint", stamp,
+                                    (x, y, 0.0, *yaw_to_quaternion(yaw)), "test")
+
+
+def test_points_are_moved_by_the_robots_motion_since_the_scan():
+    """A scan 0.4 s old (a loaded machine): the robot has driven 0.2 m since. The point seen
+    0.8 m ahead is 0.6 m ahead now, inside the stopping box at 0.5 m/s (0.4 + 0.25): brake.
+    Measured from where the robot was when the laser fired, it was not."""
+    reflex, nav_state, actions = make_reflex(clock=Clock(1000.4))
+    nav_state.set("laser1", scan([(0.8, 0.0, 0.2)], stamp=1000.0))
+    _odometry(reflex, [(1000.0, 3.0, 1.0, 0.0), (1000.2, 3.1, 1.0, 0.0),
+                       (1000.4, 3.2, 1.0, 0.0)])
+    assert reflex.check_and_mitigate(nav_state, Twist(vx=0.5))
+    assert "(0.60, 0.00)" in reflex.reason
+    assert reflex._cloud.points_stamp == 1000.4  # as of the newest odometry: no latency
+
+
+def test_what_no_odometry_has_told_yet_is_driven_at_the_command():
+    """The same scan, 0.4 s old, and odometry that stops at the scan's stamp (it is late too):
+    the robot has driven on at the commanded 0.5 m/s for 0.4 s since, so the stopping box
+    starts 0.2 m further out. Without that latency the point was beyond it."""
+    for now, expected in ((1000.0, False), (1000.4, True)):
+        reflex, nav_state, _ = make_reflex(clock=Clock(now))
+        nav_state.set("laser1", scan([(0.8, 0.0, 0.2)], stamp=1000.0))
+        _odometry(reflex, [(999.8, 3.0, 1.0, 0.0), (1000.0, 3.1, 1.0, 0.0)])
+        assert reflex.check_and_mitigate(nav_state, Twist(vx=0.5)) is expected
+
+
+def test_first_collision_with_latency_against_the_stopping_distance():
+    """Straight ahead at v: the point is hit when it lies within R + v·latency + v²/(2a)."""
+    v, a, reach, latency = 0.4, 0.5, 0.4, 0.3
+    edge = reach + v * latency + v * v / (2 * a)
+    near = np.array([(edge - 1e-3, 0.0, 0.2)])
+    far = np.array([(edge + 1e-3, 0.0, 0.2)])
+    assert first_collision(near, v, 0.0, 0.0, reach, a, latency) is not None
+    assert first_collision(far, v, 0.0, 0.0, reach, a, latency) is None
+    assert first_collision(near, v, 0.0, 0.0, reach, a) is None  # no latency: out of reach
+
+
+def test_points_carried_through_a_turn():
+    """The robot turned 90° left on the spot since the scan: a point seen 1 m ahead is 1 m to
+    its right now; one whose stamp odometry does not cover stays where it was seen."""
+    reflex, nav_state, _ = make_reflex()
+    _odometry(reflex, [(1000.0, 2.0, 2.0, 0.3), (1000.5, 2.0, 2.0, 0.3 + np.pi / 2)])
+    nav_state.set("laser1", scan([(1.0, 0.0, 0.2)], stamp=1000.0))
+    nav_state.set("laser2", scan([(0.0, 2.0, 0.2)], stamp=1001.0))  # newer than odometry
+    reflex._cloud.update(nav_state, "base_footprint")
+    carried = reflex._cloud.carried_to_latest("odom")
+    np.testing.assert_allclose(carried, [(0.0, -1.0, 0.2), (0.0, 2.0, 0.2)], atol=1e-9)
+    assert reflex._cloud.carried_to_latest("odom") is carried  # cached until odometry moves
 
 
 def test_no_command_and_no_motion_are_not_checked():

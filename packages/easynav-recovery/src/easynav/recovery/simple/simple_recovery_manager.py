@@ -190,8 +190,10 @@ class SimpleRecoveryManager(RecoveryManagerBase):
         return command is not None and command.vx > 0.0
 
     def _obstacle_ahead(self, nav_state: NavState) -> bool:
-        frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
-        points = self._cloud.update(nav_state, frame)
+        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        self._cloud.update(nav_state, tf_info.robot_footprint_frame)
+        # Where the points are now, not where they were when the sensor fired.
+        points = self._cloud.carried_to_latest(tf_info.odom_frame)
         if points.shape[0] == 0:
             return False
         r = self.robot_radius

@@ -47,13 +47,17 @@ class CollisionSafetyReflex(SafetyReflexBase):
 
     1. the points of the valid point perceptions, fused into the robot footprint frame, with
        ``z_min_filter <= z <= robot_geometry.height``, downsampled to ``downsample_leaf_size``
-       (fused once per scan, see :class:`FusedPointCloud`);
+       (fused once per scan, see :class:`FusedPointCloud`), and moved by the robot's odometry
+       since each perception's stamp (``odom → robot footprint``), as Nav2's collision
+       monitor corrects its sources for the base's motion;
     2. broad phase: the box around the robot disc of radius ``R = robot_geometry.radius +
        safety_margin``, stretched by the stopping distance ``v²/(2·brake_acc)`` in the direction
        of motion (forward, backward or sideways);
     3. closest approach per point: with the commanded twist held, each point moves relative to
-       the robot at ``(-vx + wz·y, -vy - wz·x)``; it is a collision when, within the stopping time
-       ``v/brake_acc``, a point that is getting closer comes within ``R`` of the centre. A point
+       the robot at ``(-vx + wz·y, -vy - wz·x)``; it is a collision when, within the latency
+       plus the stopping time ``v/brake_acc``, a point that is getting closer comes within
+       ``R`` of the centre. The latency is the points' age: from the newest odometry that
+       carried them (or their own stamp) to now; the box of step 2 grows by ``v·latency``. A point
        already inside the disc but getting farther does not count, so the robot can move away.
 
     On a collision it brakes: a zero OVERRIDE, published as is. Fail-safe: commanded to move
@@ -137,8 +141,9 @@ class CollisionSafetyReflex(SafetyReflexBase):
         speed = math.hypot(vx, vy)
         if not speed > MOVING_SPEED:  # NaN commands are discarded by the mux anyway
             return False
-        frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
-        points = self._cloud.update(nav_state, frame)
+        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
+        frame = tf_info.robot_footprint_frame
+        self._cloud.update(nav_state, frame)
         if self._cloud.usable_count == 0:
             self.reason = (
                 "no valid point perception while commanded to move"
@@ -146,10 +151,16 @@ class CollisionSafetyReflex(SafetyReflexBase):
                 else f"no point perception can be transformed into '{frame}'"
             )
             return True
+        # Where the points are as of the newest odometry, not where they were when the sensor
+        # fired; what the robot drove since that odometry (a loaded machine delivers it late
+        # too) is the latency, at the commanded twist.
+        points = self._cloud.carried_to_latest(tf_info.odom_frame)
+        latency = self.now() - self._cloud.points_stamp
+        latency = latency if latency > 0.0 else 0.0  # NaN (no points) and clock skew: none
         reach = self.robot_radius + self.safety_margin
-        hit = first_collision(points, vx, vy, wz, reach, self.brake_acc)
+        hit = first_collision(points, vx, vy, wz, reach, self.brake_acc, latency)
         if self.debug_markers:
-            self._show(frame, points, vx, vy, reach, hit is not None)
+            self._show(frame, points, vx, vy, reach, hit is not None, latency)
         if hit is None:
             return False
         self.reason = (
@@ -159,8 +170,8 @@ class CollisionSafetyReflex(SafetyReflexBase):
 
 
     def _show(self, frame: str, points: np.ndarray, vx: float, vy: float, reach: float,
-              imminent: bool) -> None:
-        x_lo, x_hi, y_lo, y_hi = stopping_box(vx, vy, reach, self.brake_acc)
+              imminent: bool, latency: float = 0.0) -> None:
+        x_lo, x_hi, y_lo, y_hi = stopping_box(vx, vy, reach, self.brake_acc, latency)
         lower = (x_lo, y_lo, self.z_min_filter)
         upper = (x_hi, y_hi, self.robot_height)
         inside = points[in_box(points, lower, upper)] if points.shape[0] else points
@@ -170,13 +181,13 @@ class CollisionSafetyReflex(SafetyReflexBase):
             self._marker_publisher.publish(zone_markers(self.last_zone))
 
 
-def stopping_box(vx: float, vy: float, reach: float,
-                 brake_acc: float) -> tuple[float, float, float, float]:
+def stopping_box(vx: float, vy: float, reach: float, brake_acc: float,
+                 latency: float = 0.0) -> tuple[float, float, float, float]:
     """``(x_min, x_max, y_min, y_max)`` of the broad phase: the box around the robot disc of
-    radius ``reach``, stretched by the stopping distance ``v²/(2·brake_acc)`` in the direction
-    of motion."""
+    radius ``reach``, stretched in the direction of motion by the way driven in ``latency``
+    seconds plus the stopping distance ``v²/(2·brake_acc)``."""
     speed = math.hypot(vx, vy)
-    stop_distance = speed * speed / (2.0 * brake_acc)
+    stop_distance = speed * latency + speed * speed / (2.0 * brake_acc)
     ext_x = stop_distance * vx / speed if speed > 0.0 else 0.0
     ext_y = stop_distance * vy / speed if speed > 0.0 else 0.0
     return (-reach + min(0.0, ext_x), reach + max(0.0, ext_x),
@@ -202,18 +213,20 @@ def zone_markers(zone: CollisionZone) -> Any:
 
 
 def first_collision(
-    points: np.ndarray, vx: float, vy: float, wz: float, reach: float, brake_acc: float
+    points: np.ndarray, vx: float, vy: float, wz: float, reach: float, brake_acc: float,
+    latency: float = 0.0,
 ) -> tuple[float, float] | None:
     """The ``(x, y)`` of a point the robot would hit before stopping, or None.
 
-    ``points`` ``(N, 3)`` in the robot footprint frame; ``reach`` is the radius of the robot disc
-    (with its margin); braking at ``brake_acc`` from the linear speed ``hypot(vx, vy)``.
+    ``points`` ``(N, 3)`` in the robot footprint frame as it was ``latency`` seconds ago (the
+    robot has driven on at the commanded twist since); ``reach`` is the radius of the robot
+    disc (with its margin); braking at ``brake_acc`` from the linear speed ``hypot(vx, vy)``.
     """
     if points.shape[0] == 0:
         return None
     speed = math.hypot(vx, vy)
-    t_stop = speed / brake_acc
-    x_lo, x_hi, y_lo, y_hi = stopping_box(vx, vy, reach, brake_acc)
+    t_stop = latency + speed / brake_acc
+    x_lo, x_hi, y_lo, y_hi = stopping_box(vx, vy, reach, brake_acc, latency)
     x, y = points[:, 0], points[:, 1]
     box = (x >= x_lo) & (x <= x_hi) & (y >= y_lo) & (y <= y_hi)
     if not np.any(box):
