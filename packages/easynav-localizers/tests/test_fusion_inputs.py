@@ -264,6 +264,25 @@ def test_a_late_absolute_pose_is_moved_on_by_the_estimated_motion():
     assert filt.time == pytest.approx(1.0)
 
 
+def test_a_measurement_stamped_long_before_the_estimate_is_not_moved_on():
+    """A pose stamped 0 (no clock) fused at t = 1000 is not a measurement 1000 s late: moved
+    on by the velocity times that lag it threw the estimate 400 m away; beyond MAX_LAG it is
+    fused as it is (as robot_localization does)."""
+    pose_input = FusionInput("pose", 0, "pose", [True, True] + [False] * 13,
+                             pose_threshold=sys.float_info.max)
+    ukf = UkfFilter(two_d_mode=True, initial_covariance=np.diag([1.0] * 2 + [1e-9] * 4
+                                                                + [1.0] * 9))
+    filt = FusionFilter(ukf, [pose_input])
+    filt.ukf.set_variables([VX], [0.4], [1e-6])
+    filt.add_odometry("pose0", Odometry(header=Header(1000.0, "map"),
+                                        pose=Pose.from_xy_yaw(0.0, 0.0, 0.0),
+                                        pose_covariance=np.eye(6) * 1e-4))
+    before = filt.ukf.state[:2].copy()
+    filt.add_odometry("pose0", Odometry(header=Header(0.0, "map"), pose=Pose.from_xy_yaw(
+        *before, 0.0), pose_covariance=np.eye(6) * 1e-4))
+    assert np.linalg.norm(filt.ukf.state[:2] - before) < 0.01
+
+
 # -- poseN / odomN ----------------------------------------------------------------------------
 def test_differential_pose_is_gated_by_its_rejection_threshold():
     source = FusionInput("pose", 0, "pose", [True, True] + [False] * 13, differential=True,

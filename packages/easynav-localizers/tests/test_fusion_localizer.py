@@ -385,10 +385,13 @@ def test_carry_pose_moves_a_pose_by_the_odometry_since_its_stamp():
     later = in_map(_arc(3.4))
     carried = carry_pose(buffer, *then, 1.0, 3.4, twist=(0.5, 0.0, 0.3))
     np.testing.assert_allclose(carried[:2], later[:2], atol=2e-3)
-    # No odometry transforms: the twist alone (the arc's chord at the middle heading).
+    # No odometry transforms: the twist alone (the arc's chord at the middle heading), for
+    # one second at most (the robot may have braked meanwhile).
     empty = TFBuffer()
+    carried = carry_pose(empty, *then, 1.0, 1.8, twist=(0.5, 0.0, 0.3))
+    np.testing.assert_allclose(carried, in_map(_arc(1.8)), atol=1e-2)  # chord vs arc: 2 mm
     carried = carry_pose(empty, *then, 1.0, 2.5, twist=(0.5, 0.0, 0.3))
-    np.testing.assert_allclose(carried, now, atol=1e-2)  # chord vs arc: 6 mm
+    np.testing.assert_allclose(carried, in_map(_arc(2.0)), atol=1e-2)
     assert carry_pose(empty, *then, 1.0, 2.5) == then
     # Unstamped (0) or not older than ``until``: unchanged.
     assert carry_pose(buffer, *then, 0.0, 2.5) == then
@@ -436,6 +439,42 @@ def test_a_handed_over_pose_is_carried_to_the_first_measurement():
     truth = _arc(3.0)
     assert math.hypot(estimate.pose.x - truth[0], estimate.pose.y - truth[1]) < 0.01
     assert abs(estimate.pose.yaw - truth[2]) < 0.01
+
+
+def test_a_pose_stamped_on_another_clock_is_taken_as_of_now():
+    """An initialpose from a tool on wall time (1.7e9 s) while the robot runs on simulated
+    time (t = 2): the pose is applied as of the next measurement. Taken at its stamp, it moved
+    the filter's clock to 1.7e9 and every later measurement was "late": the estimate stood."""
+    params = {
+        "Ukf.global_filter.two_d_mode": True,
+        "Ukf.global_filter.publish_tf": False,
+        "Ukf.global_filter.odom0": "odom",
+        "Ukf.global_filter.odom0_config": [False] * 6 + [True, False, False,
+                                                         False, False, True] + [False] * 3,
+    }
+    clock = {"t": 0.0}
+    plugin = FusionLocalizer()
+    plugin.initialize(PluginContext(parameters=DictParameters(params),
+                                    namespace=f"fusion_clock_{next(_namespaces)}",
+                                    now=lambda: clock["t"]), "Ukf")
+    nav_state = NavState()
+
+    def drive(start: int, end: int) -> None:  # 1 m/s along x, 50 Hz
+        for k in range(start, end):
+            clock["t"] = k * 0.02
+            plugin.add_odometry("global_filter", "odom0", Odometry(
+                header=Header(clock["t"], "odom"), twist=Twist(vx=1.0),
+                twist_covariance=np.eye(6) * 1e-6))
+            plugin.update_rt(nav_state)
+
+    drive(1, 100)
+    plugin.on_last_known_pose(Odometry(header=Header(1.7e9, "map"),
+                                       pose=Pose.from_xy_yaw(10.0, 0.0, 0.0),
+                                       pose_covariance=np.eye(6) * 1e-4))
+    drive(100, 201)  # 2 s more at 1 m/s
+    estimate = nav_state.get("robot_pose", Odometry)
+    assert estimate.header.stamp == pytest.approx(4.0)
+    assert estimate.pose.x == pytest.approx(12.0, abs=0.1)  # (not 10: it stood)
 
 
 def test_a_late_fix_does_not_pull_the_estimate_back():

@@ -165,6 +165,31 @@ def test_points_carried_through_a_turn():
     assert reflex._cloud.carried_to_latest("odom") is carried  # cached until odometry moves
 
 
+def test_a_perception_in_the_odom_frame_is_carried_from_the_transform_it_was_fused_with():
+    """A cloud in the odom frame (a fixed frame), newer than the last odometry when it is
+    fused: the fusion takes the latest transform (t = 1, robot at x = 0.5), so its points are
+    where they are relative to the robot *then*; carried from their own stamp (1.5) instead,
+    the obstacle came out 0.25 m farther than it is."""
+    reflex, nav_state, _ = make_reflex()
+    _odometry(reflex, [(0.0, 0.0, 0.0, 0.0), (1.0, 0.5, 0.0, 0.0)])
+    nav_state.set("cloud", scan([(2.0, 0.0, 0.2)], frame="odom", stamp=1.5))
+    cloud = reflex._cloud
+    np.testing.assert_allclose(cloud.update(nav_state, "base_footprint"), [(1.5, 0.0, 0.2)])
+    _odometry(reflex, [(2.0, 1.0, 0.0, 0.0)])
+    np.testing.assert_allclose(cloud.carried_to_latest("odom"), [(1.0, 0.0, 0.2)], atol=1e-9)
+
+
+def test_a_transform_sent_again_with_its_stamp_renews_the_carried_points():
+    reflex, nav_state, _ = make_reflex()
+    _odometry(reflex, [(1.0, 0.0, 0.0, 0.0), (2.0, 0.5, 0.0, 0.0)])
+    nav_state.set("laser1", scan([(2.0, 0.0, 0.2)], stamp=1.0))
+    cloud = reflex._cloud
+    cloud.update(nav_state, "base_footprint")
+    np.testing.assert_allclose(cloud.carried_to_latest("odom"), [(1.5, 0.0, 0.2)])
+    _odometry(reflex, [(2.0, 0.75, 0.0, 0.0)])  # corrected, same stamp
+    np.testing.assert_allclose(cloud.carried_to_latest("odom"), [(1.25, 0.0, 0.2)])
+
+
 def test_no_command_and_no_motion_are_not_checked():
     reflex, nav_state, _ = make_reflex()
     assert not reflex.check_and_mitigate(nav_state, None)

@@ -22,7 +22,7 @@ from easynav.core.types import (
     Twist,
 )
 from easynav.core.warning_throttle import WarningThrottle
-from easynav.localizers.fusion.fusion_filter import FusionFilter, quaternion_to_rpy
+from easynav.localizers.fusion.fusion_filter import MAX_LAG, FusionFilter, quaternion_to_rpy
 from easynav.localizers.fusion.fusion_parameters import (
     FILTER_PARAMETERS,
     FILTER_PREFIXES,
@@ -47,6 +47,9 @@ ROBOT_POSE_LOCAL = NavStateKey(
 )
 #: The NavState group the sensors node puts GNSS receivers in (matched to gpsN by order).
 GNSS_GROUP = "gnss"
+#: A handed-over pose stamped more than this (s) before the first measurement after it is
+#: taken as of that measurement (not carried): the TF buffer's default history.
+HANDOVER_WINDOW = 10.0
 
 _PLUGIN_PARAMETERS = (
     Param("latitude_origin", 0.0, "geodetic origin of the map frame: latitude", "deg",
@@ -256,10 +259,12 @@ class FusionLocalizer(LocalizerMethodBase):
 
     def on_last_known_pose(self, pose: Odometry) -> None:
         """Continue from ``pose`` (map frame): the global filter jumps there (GNSS shifted to
-        agree), the local filter keeps its odom-frame estimate. The jump waits for the next
-        cycle with measurements: the pose is first carried by the odometry from its stamp to
-        the first of them (:func:`carry_pose`), since the robot may have driven on in between
-        (a reconfiguration takes a second or more)."""
+        agree, once a fix has placed the filter), the local filter keeps its odom-frame
+        estimate. The jump happens in the next cycle (a fresh filter: the next one with
+        measurements): the pose is first carried by the odometry from its stamp to the first
+        measurement (:func:`carry_pose`), since the robot may have driven on in between (a
+        reconfiguration takes a second or more). A stamp of 0, or one more than 10 s before
+        or 1 s after the measurements (another clock), is taken as "now"."""
         with self._lock:
             self._handover = pose
         self.logger.info(
@@ -270,18 +275,30 @@ class FusionLocalizer(LocalizerMethodBase):
     def _take_over(self, filt: FusionFilter, events: list, buffer) -> list:
         """Apply the pending handover to the global filter ``filt`` before ``events`` (sorted)
         are fused; returns the events left to fuse (those older than the pose describe motion
-        it already includes). Without events (and no filter time) it waits. Under the lock."""
+        it already includes). A fresh filter without events waits for them; a running one
+        takes the pose at its own time. Under the lock."""
         pose = self._handover
-        stamp = pose.header.stamp
         if events:
-            until = max(stamp, events[0][0])
-            events = [e for e in events if e[0] >= until]
+            reference = events[0][0]
         elif filt.time is not None:
-            until = max(stamp, filt.time)
+            reference = filt.time
         else:
             return events
         self._handover = None
+        stamp = pose.header.stamp
+        if not reference - HANDOVER_WINDOW <= stamp <= reference + MAX_LAG:
+            # Unstamped (0), or on another clock (an initialpose from a tool on wall time
+            # while the robot runs on simulated time): the pose is taken as of now.
+            stamp = 0.0
+        until = max(stamp, reference)
+        events = [e for e in events if e[0] >= until]
+        # The motion between the pose's stamp and ``until`` at constant velocity, when no
+        # odometry transforms cover it: the pose's own, or the running filter's (an
+        # initialpose has none).
         twist = (pose.twist.vx, pose.twist.vy, pose.twist.wz)
+        if filt.time is not None and filt.initialized:
+            state = filt.ukf.state
+            twist = (float(state[VX]), float(state[VY]), float(state[VYAW]))
         x, y, yaw = carry_pose(buffer, pose.pose.x, pose.pose.y, pose.pose.yaw, stamp, until,
                                twist)
         if stamp > 0.0 and until > stamp:
@@ -289,7 +306,8 @@ class FusionLocalizer(LocalizerMethodBase):
                 f"{self.plugin_name}: the pose of t={stamp:.3f} carried to t={until:.3f}: "
                 f"({x:.3f}, {y:.3f}, {yaw:.3f})")
         cov = np.asarray(pose.pose_covariance, dtype=float).reshape(6, 6)
-        filt.reset_pose(x, y, yaw, cov, time=until, twist=twist)
+        filt.reset_pose(x, y, yaw, cov, time=until,
+                        twist=(pose.twist.vx, pose.twist.vy, pose.twist.wz))
         return events
 
     # -- cycle ---------------------------------------------------------------------------------

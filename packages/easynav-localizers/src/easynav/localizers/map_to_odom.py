@@ -17,6 +17,10 @@ from easynav.core.types import (
     yaw_to_quaternion,
 )
 
+#: The longest time (s) :func:`carry_pose` moves a pose at constant velocity, where odometry
+#: does not tell the motion.
+MAX_TWIST_EXTRAPOLATION = 1.0
+
 
 def map_to_odom(buffer: TFBuffer, x: float, y: float, yaw: float, stamp: float,
                 twist: Sequence[float] | None = None) -> TransformStamped:
@@ -75,8 +79,9 @@ def carry_pose(buffer: TFBuffer, x: float, y: float, yaw: float, stamp: float, u
     distance (0.25 m at 0.27 m/s) for the rest of a mission on odometry alone.
 
     Without an ``odom → robot`` transform (a robot that gives none, or no history back to
-    ``stamp``) the pose is moved at constant body velocity ``twist`` ``(vx, vy, vyaw)``, and
-    kept as it is when ``twist`` is None. A ``stamp`` of 0 (unstamped, as an ``initialpose``
+    ``stamp``) the pose is moved at constant body velocity ``twist`` ``(vx, vy, vyaw)``, for
+    :data:`MAX_TWIST_EXTRAPOLATION` at most (the robot may have braked meanwhile), and kept as
+    it is when ``twist`` is None. A ``stamp`` of 0 (unstamped, as an ``initialpose``
     may be) means "now": the pose is returned unchanged. Pure computation on the buffer; any
     thread.
     """
@@ -93,12 +98,13 @@ def carry_pose(buffer: TFBuffer, x: float, y: float, yaw: float, stamp: float, u
         odom_stamp, (ox, oy, _, qx, qy, qz, qw) = buffer.lookup_transform_values_near(
             tf_info.odom_frame, tf_info.robot_footprint_frame, until)
     except LookupError:
-        return (x, y, yaw) if twist is None else _move(x, y, yaw, twist, until - stamp)
+        return (x, y, yaw) if twist is None else _move(
+            x, y, yaw, twist, min(until - stamp, MAX_TWIST_EXTRAPOLATION))
     m_yaw = quaternion_to_yaw(*anchor.rotation)
     c, s = math.cos(m_yaw), math.sin(m_yaw)
     mx, my = float(anchor.translation[0]), float(anchor.translation[1])
     x, y = mx + c * ox - s * oy, my + s * ox + c * oy
     yaw = normalize_angle(m_yaw + quaternion_to_yaw(qx, qy, qz, qw))
     if twist is not None and odom_stamp != until:  # odometry ends before ``until``
-        x, y, yaw = _move(x, y, yaw, twist, until - odom_stamp)
+        x, y, yaw = _move(x, y, yaw, twist, min(until - odom_stamp, MAX_TWIST_EXTRAPOLATION))
     return x, y, yaw

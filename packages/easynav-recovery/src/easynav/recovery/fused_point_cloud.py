@@ -59,7 +59,7 @@ class FusedPointCloud:
         self._point_stamps = np.empty(0)
         self._frame = ""
         self._sources: list[PointPerception] = []
-        self._carried: tuple[tuple[str, float], np.ndarray, float] | None = None
+        self._carried: tuple[tuple, np.ndarray, float] | None = None
         self.points_stamp = math.nan
 
     def update(self, nav_state: NavState, target_frame: str) -> np.ndarray:
@@ -81,23 +81,16 @@ class FusedPointCloud:
             for key, p in valid.items()
             if p.frame_id == target_frame or buffer.can_transform(target_frame, p.frame_id)
         }
-        # One perception at a time, so that each point keeps the stamp it was seen at.
-        parts = [PointPerceptionsOps({key: p}, buffer, self.logger).fuse(target_frame).as_points()
-                 for key, p in usable.items()]
+        # One perception at a time: each point keeps the time its robot-frame position is of,
+        # and downsampling never trades a point of one scan for another's older one.
+        parts, stamps = [], []
+        for key, p in usable.items():
+            part = self._filtered(
+                PointPerceptionsOps({key: p}, buffer, self.logger).fuse(target_frame).as_points())
+            parts.append(part)
+            stamps.append(np.full(part.shape[0], self._taken_at(buffer, p, target_frame)))
         points = np.concatenate(parts) if parts else np.empty((0, 3))
-        stamps = np.concatenate([np.full(part.shape[0], p.stamp, dtype=float)
-                                 for part, p in zip(parts, usable.values(), strict=True)]) \
-            if parts else np.empty(0)
-        if points.shape[0] and (self.z_min > -math.inf or self.z_max < math.inf):
-            z = points[:, 2]
-            if self.strict_z:
-                mask = (z > self.z_min) & (z < self.z_max)
-            else:
-                mask = (z >= self.z_min) & (z <= self.z_max)
-            points, stamps = points[mask], stamps[mask]
-        if self.leaf_size and points.shape[0] > 1:
-            keep = voxel_downsample_indices(points, self.leaf_size)
-            points, stamps = points[keep], stamps[keep]
+        stamps = np.concatenate(stamps) if stamps else np.empty(0)
         self._points = points
         self._point_stamps = stamps
         self._carried = None
@@ -107,6 +100,31 @@ class FusedPointCloud:
         self.usable_count = len(usable)
         self.stamp = max((p.stamp for p in usable.values()), default=math.nan)
         return points
+
+    def _filtered(self, points: np.ndarray) -> np.ndarray:
+        """``points`` within the z limits, downsampled to ``leaf_size``."""
+        if points.shape[0] and (self.z_min > -math.inf or self.z_max < math.inf):
+            z = points[:, 2]
+            if self.strict_z:
+                points = points[(z > self.z_min) & (z < self.z_max)]
+            else:
+                points = points[(z >= self.z_min) & (z <= self.z_max)]
+        if self.leaf_size and points.shape[0] > 1:
+            points = points[voxel_downsample_indices(points, self.leaf_size)]
+        return points
+
+    @staticmethod
+    def _taken_at(buffer, perception: PointPerception, target_frame: str) -> float:
+        """The time the fused points of ``perception`` describe relative to ``target_frame``:
+        its stamp, unless the transform was not known then and the fusion took the latest
+        (a perception in a fixed frame such as odom, newer than the last odometry)."""
+        frame, stamp = perception.frame_id, perception.stamp
+        if frame == target_frame or buffer.can_transform(target_frame, frame, stamp):
+            return float(stamp)
+        try:
+            return buffer.latest_common_time(target_frame, frame)
+        except LookupError:
+            return float(stamp)
 
     def carried_to_latest(self, odom_frame: str) -> np.ndarray:
         """The points of the last :meth:`update`, moved into its target frame as that frame is
@@ -118,7 +136,7 @@ class FusedPointCloud:
         uses measured motion. Afterwards :attr:`points_stamp` is the time the returned points
         describe, the oldest of theirs (the newest transform's stamp for the points carried,
         their own for the others; NaN without points): the robot may have moved since by
-        what no transform has told yet. Cached until the next scan or the next odometry
+        what no transform has told yet. Cached until the next scan or a new newest odometry
         transform; any thread that owns the instance.
         """
         points = self._points
@@ -131,7 +149,7 @@ class FusedPointCloud:
             latest_stamp, latest = buffer.lookup_transform_values(odom_frame, self._frame)
         except LookupError:
             return points
-        key = (odom_frame, latest_stamp)
+        key = (odom_frame, latest_stamp, latest)  # a transform re-sent with its stamp: new
         if self._carried is not None and self._carried[0] == key:
             self.points_stamp = self._carried[2]
             return self._carried[1]
@@ -139,6 +157,8 @@ class FusedPointCloud:
         out = points.copy()
         oldest = math.inf
         for stamp in np.unique(self._point_stamps):
+            if not math.isfinite(stamp):
+                continue
             try:
                 _, then = buffer.lookup_transform_values(odom_frame, self._frame, float(stamp))
             except LookupError:

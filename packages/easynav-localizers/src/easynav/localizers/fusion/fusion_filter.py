@@ -25,6 +25,10 @@ from easynav.localizers.fusion.utm_projection import UtmProjection
 
 #: Variance of a GNSS position whose covariance the receiver does not give (the original's).
 UNKNOWN_GNSS_VARIANCE = 1.0
+#: A measurement older than the estimate by more than this (s) is fused as it is, not moved on
+#: by the estimated motion: a stamp that old is more likely on another clock (0, wall time)
+#: than late, and velocity × lag would throw the estimate anywhere.
+MAX_LAG = 1.0
 
 
 def quaternion_to_rpy(qx: float, qy: float, qz: float, qw: float) -> tuple[float, float, float]:
@@ -84,13 +88,14 @@ class FusionFilter:
 
     Every measurement (:meth:`add_odometry`, :meth:`add_imu`, :meth:`add_gnss`, ...) first
     predicts the filter to its stamp (a measurement older than the last one is fused without
-    prediction; a GNSS fix older than the estimate is first moved on by the estimated motion
-    since its stamp), then fuses the variables its input's ``_config`` selects, each part behind
-    its Mahalanobis gate. A GNSS fix (status ≥ FIX) becomes a position in the local frame:
-    UTM of the fix minus UTM of the geodetic origin (origin's zone), plus :attr:`gnss_offset`
-    (moved by :meth:`reset_pose`). With GNSS inputs the filter is uninitialised until the first
-    fix, which sets x and y (and yaw from the last IMU orientation, if any); without them, the
-    first measurement initialises it.
+    prediction, its absolute parts — x, y, yaw of a pose, an IMU attitude, a GNSS fix — first
+    moved on by the estimated motion since its stamp, up to :data:`MAX_LAG`), then fuses the
+    variables its input's ``_config`` selects, each part behind its Mahalanobis gate. A GNSS
+    fix (status ≥ FIX) becomes a position in the local frame: UTM of the fix minus UTM of the
+    geodetic origin (origin's zone), plus :attr:`gnss_offset` (moved by :meth:`reset_pose`).
+    With GNSS inputs the filter is uninitialised until the first fix, which sets x and y (and
+    yaw from the last IMU orientation, if any); without them, the first measurement
+    initialises it.
 
     ``_relative`` inputs are taken relative to their first message (a pose in the frame of the
     first pose; a fix minus the first fix, so the first fix is the origin). ``_differential``
@@ -225,7 +230,7 @@ class FusionFilter:
         if source.relative:  # the first fix is the origin
             position = position - self._first_pose.setdefault(name, position.copy())
         position[:2] += self.gnss_offset
-        if self.initialized and self.time is not None and fix.stamp < self.time:
+        if self._lag(fix.stamp) > 0.0:
             # A fix older than the estimate (it came through the sensors node while odometry
             # and IMU were already fused past it): where it was then, moved on by the motion
             # since. Fused as it is, it pulled the estimate back by the distance driven in the
@@ -254,13 +259,18 @@ class FusionFilter:
         standstill firmly, and the first steps after a handover while driving were lost (1 cm
         and 0.3° a step at 0.5 m/s, kept for good by dead reckoning). A running filter keeps
         its own velocity."""
+        if time is not None and self.time is not None and time > self.time:
+            self.predict_to(time)  # the estimate the pose replaces, at the pose's time
         state = self.ukf.state
         if self.initialized:
-            self.gnss_offset += np.array((x - state[0], y - state[1]))
+            then = state[:2] - self._displacement_since(time) if (
+                time is not None and self.time is not None and time < self.time) else state[:2]
+            self.gnss_offset += np.array((x - then[0], y - then[1]))
         cov = np.asarray(covariance, dtype=float).reshape(6, 6)
         self.ukf.set_variables([0, 1, YAW], [x, y, yaw],
                                [max(cov[0, 0], 1e-6), max(cov[1, 1], 1e-6), max(cov[5, 5], 1e-6)])
-        if twist is not None and self.time is None and np.all(np.isfinite(twist)):
+        fresh = self.time is None or not self.initialized  # nothing corrected yet
+        if twist is not None and fresh and np.all(np.isfinite(twist)):
             self.ukf.set_variables([VX, VY, VYAW], [float(v) for v in twist], [1.0] * 3)
         self.initialized = True
         self._previous_pose.clear()
@@ -335,15 +345,18 @@ class FusionFilter:
         velocity (constant over the lag)."""
         state = self.ukf.state
         lag = self.time - stamp
-        c, s = math.cos(state[YAW]), math.sin(state[YAW])
+        heading = state[YAW] - 0.5 * state[VYAW] * lag  # the heading halfway through the lag
+        c, s = math.cos(heading), math.sin(heading)
         vx, vy = state[VX], state[VY]
         return np.array((c * vx - s * vy, s * vx + c * vy)) * lag
 
     def _lag(self, stamp: float) -> float:
-        """How much older than the estimate a measurement stamped ``stamp`` is (0 when not)."""
+        """How much older than the estimate a measurement stamped ``stamp`` is: 0 when it is
+        not, or when it is older by more than :data:`MAX_LAG`."""
         if not self.initialized or self.time is None or stamp >= self.time:
             return 0.0
-        return self.time - stamp
+        lag = self.time - stamp
+        return lag if lag <= MAX_LAG else 0.0
 
     def _moved_on(self, idx: Sequence[int], values: np.ndarray, lag: float) -> np.ndarray:
         """Absolute measurements of state variables ``idx`` taken ``lag`` seconds before the
