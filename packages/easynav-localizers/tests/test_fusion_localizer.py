@@ -398,6 +398,23 @@ def test_carry_pose_moves_a_pose_by_the_odometry_since_its_stamp():
     assert carry_pose(buffer, *then, 2.5, 2.5) == then
 
 
+def _odometry_fusion(clock: dict, publish_tf: bool) -> tuple[FusionLocalizer, str]:
+    """A FusionLocalizer whose global filter fuses the odometry's vx and vyaw only, on the
+    clock ``clock["t"]``, in a TF namespace of its own (returned)."""
+    params = {
+        "Ukf.global_filter.two_d_mode": True,
+        "Ukf.global_filter.publish_tf": publish_tf,
+        "Ukf.global_filter.odom0": "odom",
+        "Ukf.global_filter.odom0_config": [False] * 6 + [True, False, False,
+                                                         False, False, True] + [False] * 3,
+    }
+    namespace = f"fusion_odometry_{next(_namespaces)}"
+    plugin = FusionLocalizer()
+    plugin.initialize(PluginContext(parameters=DictParameters(params), namespace=namespace,
+                                    now=lambda: clock["t"]), "Ukf")
+    return plugin, namespace
+
+
 def test_a_handed_over_pose_is_carried_to_the_first_measurement():
     """A localizer swap: the previous localizer's last pose is stamped when it last ran
     (t = 1.0); the fusion localizer starts fusing 1.5 s later, with odometry messages from
@@ -406,18 +423,8 @@ def test_a_handed_over_pose_is_carried_to_the_first_measurement():
     at t = 1.0 (0.75 m behind, for the rest of a mission on odometry alone)."""
     from easynav.common.tf import get_tf_buffer
 
-    params = {
-        "Ukf.global_filter.two_d_mode": True,
-        "Ukf.global_filter.publish_tf": True,
-        "Ukf.global_filter.odom0": "odom",
-        "Ukf.global_filter.odom0_config": [False] * 6 + [True, False, False,
-                                                         False, False, True] + [False] * 3,
-    }
-    namespace = f"fusion_handover_{next(_namespaces)}"
     clock = {"t": 1.0}
-    plugin = FusionLocalizer()
-    plugin.initialize(PluginContext(parameters=DictParameters(params), namespace=namespace,
-                                    now=lambda: clock["t"]), "Ukf")
+    plugin, namespace = _odometry_fusion(clock, publish_tf=True)
     buffer = get_tf_buffer(namespace)
     _turning_odometry(buffer, 2.5)
     # Map and odom coincide: the previous localizer's pose at t = 1 is the arc's.
@@ -445,18 +452,8 @@ def test_a_pose_stamped_on_another_clock_is_taken_as_of_now():
     """An initialpose from a tool on wall time (1.7e9 s) while the robot runs on simulated
     time (t = 2): the pose is applied as of the next measurement. Taken at its stamp, it moved
     the filter's clock to 1.7e9 and every later measurement was "late": the estimate stood."""
-    params = {
-        "Ukf.global_filter.two_d_mode": True,
-        "Ukf.global_filter.publish_tf": False,
-        "Ukf.global_filter.odom0": "odom",
-        "Ukf.global_filter.odom0_config": [False] * 6 + [True, False, False,
-                                                         False, False, True] + [False] * 3,
-    }
     clock = {"t": 0.0}
-    plugin = FusionLocalizer()
-    plugin.initialize(PluginContext(parameters=DictParameters(params),
-                                    namespace=f"fusion_clock_{next(_namespaces)}",
-                                    now=lambda: clock["t"]), "Ukf")
+    plugin, _ = _odometry_fusion(clock, publish_tf=False)
     nav_state = NavState()
 
     def drive(start: int, end: int) -> None:  # 1 m/s along x, 50 Hz
