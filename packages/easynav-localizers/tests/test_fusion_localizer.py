@@ -474,6 +474,51 @@ def test_a_pose_stamped_on_another_clock_is_taken_as_of_now():
     assert estimate.pose.x == pytest.approx(12.0, abs=0.1)  # (not 10: it stood)
 
 
+def test_map_to_odom_takes_the_estimate_of_the_transforms_time_from_the_history():
+    """TF's newest odom -> robot is 0.9 s behind the estimate (the TF listener's queue lags
+    the odometry subscription under load) and the filter's velocity is noisy (0.2 m/s here,
+    against 0.3): moved back by it, map -> odom was 0.09 m off. The estimate the filter had
+    at the transform's time, from its history, is exact."""
+    from easynav.common.tf import TFBuffer
+    from easynav.core.types import Transform, TransformStamped
+    from easynav.localizers.map_to_odom import PoseHistory, map_to_odom
+
+    buffer = TFBuffer()
+    history = PoseHistory()
+    shift = (5.0, 3.0)  # map = odom shifted
+    for k in range(0, 101):  # 0.3 m/s along x, odom -> robot up to t = 1.1 only
+        t = k * 0.02
+        if t <= 1.1 + 1e-9:
+            buffer.set_transform(TransformStamped(
+                Header(t, "odom"), "base_footprint",
+                Transform(np.array((0.3 * t, 0.0, 0.0)), np.array((0.0, 0.0, 0.0, 1.0)))),
+                "test")
+        history.add(t, shift[0] + 0.3 * t, shift[1], 0.0)
+    stamp = 2.0
+    estimate = (shift[0] + 0.3 * stamp, shift[1], 0.0)
+    with_history = map_to_odom(buffer, *estimate, stamp, twist=(0.2, 0.0, 0.0),
+                               history=history)
+    np.testing.assert_allclose(with_history.transform.translation[:2], shift, atol=1e-9)
+    twist_only = map_to_odom(buffer, *estimate, stamp, twist=(0.2, 0.0, 0.0))
+    assert abs(twist_only.transform.translation[0] - shift[0]) > 0.08
+
+
+def test_pose_history_interpolates_within_its_span():
+    from easynav.localizers.map_to_odom import PoseHistory
+
+    history = PoseHistory(span=1.0)
+    history.add(0.0, 0.0, 0.0, math.pi - 0.1)
+    history.add(1.0, 1.0, 2.0, -math.pi + 0.1)  # across ±π
+    history.add(0.5, 9.0, 9.0, 0.0)  # older than the last: ignored
+    x, y, yaw = history.at(0.5)
+    assert (x, y) == pytest.approx((0.5, 1.0)) and abs(abs(yaw) - math.pi) < 1e-9
+    assert history.at(-0.1) is None and history.at(1.1) is None
+    history.add(2.5, 3.0, 3.0, 0.0)  # the span drops what is older than 1 s
+    assert history.at(1.0) is None and history.at(2.5) == (3.0, 3.0, 0.0)
+    history.clear()
+    assert history.at(2.5) is None
+
+
 def test_a_late_fix_does_not_pull_the_estimate_back():
     """A fix that arrives after odometry has carried the estimate past its stamp (the sensors
     node runs apart from the RT loop) is where the robot *was*: moved on by the estimated

@@ -39,7 +39,7 @@ from easynav.localizers.fusion.ukf_filter import (
     UkfFilter,
     square_matrix,
 )
-from easynav.localizers.map_to_odom import carry_pose, map_to_odom
+from easynav.localizers.map_to_odom import PoseHistory, carry_pose, map_to_odom
 
 #: NavState keys.
 ROBOT_POSE_LOCAL = NavStateKey(
@@ -146,6 +146,8 @@ class FusionLocalizer(LocalizerMethodBase):
         self._gravity: dict[str, float] = {}
         #: The pose handed over (``on_last_known_pose``), applied on the next cycle.
         self._handover: Odometry | None = None
+        #: The global filter's recent estimates, for ``map → odom`` (RT thread).
+        self._history = PoseHistory()
 
     # -- parameters ----------------------------------------------------------------------------
     @classmethod
@@ -229,6 +231,7 @@ class FusionLocalizer(LocalizerMethodBase):
             self._gnss_stamps = {}
             self._projection = projection
             self._handover = None
+            self._history.clear()
         self._publish_tf = "global_filter" in filters and v["global_filter.publish_tf"]
         if self.context.node is not None:
             self._create_ros()
@@ -306,6 +309,7 @@ class FusionLocalizer(LocalizerMethodBase):
                 f"{self.plugin_name}: the pose of t={stamp:.3f} carried to t={until:.3f}: "
                 f"({x:.3f}, {y:.3f}, {yaw:.3f})")
         cov = np.asarray(pose.pose_covariance, dtype=float).reshape(6, 6)
+        self._history.clear()  # the estimates before the jump no longer hold
         filt.reset_pose(x, y, yaw, cov, time=until,
                         twist=(pose.twist.vx, pose.twist.vy, pose.twist.wz))
         return events
@@ -368,9 +372,11 @@ class FusionLocalizer(LocalizerMethodBase):
             nav_state.set(ROBOT_POSE if prefix == "global_filter" else ROBOT_POSE_LOCAL,
                           odometry)
             self._publish(prefix, odometry)
-        if self._publish_tf and "global_filter" in outputs:
+        if "global_filter" in outputs:
             state, _, stamp = outputs["global_filter"]
-            self._send_map_to_odom(state, stamp)
+            self._history.add(stamp, state[0], state[1], state[YAW])
+            if self._publish_tf:
+                self._send_map_to_odom(state, stamp)
 
     def _robot_in_child(self, buffer, robot_frame: str, source, odometry: Odometry):
         """For an ``odomN`` with ``_pose_use_child_frame`` whose child frame is not the robot
@@ -421,7 +427,8 @@ class FusionLocalizer(LocalizerMethodBase):
         try:
             transform = map_to_odom(buffer, float(state[0]), float(state[1]),
                                     float(state[YAW]), stamp,
-                                    twist=(state[VX], state[VY], state[VYAW]))
+                                    twist=(state[VX], state[VY], state[VYAW]),
+                                    history=self._history)
         except Exception as exc:  # no odometry transform yet: nothing to anchor map → odom on
             self._throttle.warn(self.logger, "no-odom-tf",
                                 f"{self.plugin_name}: no map → odom: {exc}")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Sequence
 
 import numpy as np
@@ -22,8 +23,54 @@ from easynav.core.types import (
 MAX_TWIST_EXTRAPOLATION = 1.0
 
 
+class PoseHistory:
+    """The recent planar estimates ``(stamp, x, y, yaw)`` of a localizer, oldest first, so
+    that :func:`map_to_odom` can take the estimate at the time of the newest ``odom → robot``
+    transform instead of moving the newest estimate there by its velocity.
+
+    Under load the TF listener's queue (depth 100) lags the localizer's own odometry
+    subscription by up to a second; moved across that gap by the filter's noisy velocity
+    estimate, ``map → odom`` jumped by up to 0.2 m between consecutive updates.
+
+    Thread contract: one owner thread (not locked).
+    """
+
+    def __init__(self, span: float = 3.0) -> None:
+        self.span = span
+        self._samples: deque[tuple[float, float, float, float]] = deque()
+
+    def add(self, stamp: float, x: float, y: float, yaw: float) -> None:
+        """Append an estimate (an older or equal stamp than the last one is ignored)."""
+        samples = self._samples
+        if samples and stamp <= samples[-1][0]:
+            return
+        samples.append((float(stamp), float(x), float(y), float(yaw)))
+        while samples and samples[0][0] < stamp - self.span:
+            samples.popleft()
+
+    def clear(self) -> None:
+        """Forget every estimate (the localizer jumped: its earlier ones no longer hold)."""
+        self._samples.clear()
+
+    def at(self, stamp: float) -> tuple[float, float, float] | None:
+        """The estimate at ``stamp``, interpolated (yaw along the shorter arc); None outside
+        the span held."""
+        samples = self._samples
+        if not samples or not samples[0][0] <= stamp <= samples[-1][0]:
+            return None
+        hi = next(i for i, sample in enumerate(samples) if sample[0] >= stamp)
+        t1, x1, y1, yaw1 = samples[hi]
+        if t1 == stamp or hi == 0:
+            return x1, y1, yaw1
+        t0, x0, y0, yaw0 = samples[hi - 1]
+        f = (stamp - t0) / (t1 - t0)
+        return (x0 + f * (x1 - x0), y0 + f * (y1 - y0),
+                normalize_angle(yaw0 + f * normalize_angle(yaw1 - yaw0)))
+
+
 def map_to_odom(buffer: TFBuffer, x: float, y: float, yaw: float, stamp: float,
-                twist: Sequence[float] | None = None) -> TransformStamped:
+                twist: Sequence[float] | None = None,
+                history: PoseHistory | None = None) -> TransformStamped:
     """``map → odom`` such that ``map → odom → robot`` is the planar estimate ``(x, y, yaw)``
     at ``stamp``, with ``odom → robot`` looked up at ``stamp``, as robot_localization does.
     With the latest transform instead, an estimate that lags its inputs (queued odometry on a
@@ -38,6 +85,9 @@ def map_to_odom(buffer: TFBuffer, x: float, y: float, yaw: float, stamp: float,
     estimate is used as it is: a pose estimated 0.4 s after the transform at 0.7 m/s put the
     robot 0.28 m ahead of itself until the next update.
 
+    With a ``history`` that holds the estimate at that transform's stamp, that estimate is
+    used instead of moving the newest one (exact where the velocity is noisy).
+
     The transform is stamped ``stamp``. Frames from the buffer's TFInfo. Raises the buffer's
     lookup errors (TransformError) when there is no ``odom → robot`` transform yet. Pure
     computation on the buffer; any thread.
@@ -45,7 +95,11 @@ def map_to_odom(buffer: TFBuffer, x: float, y: float, yaw: float, stamp: float,
     tf_info = buffer.get_tf_info()
     odom_stamp, (ox, oy, _, qx, qy, qz, qw) = buffer.lookup_transform_values_near(
         tf_info.odom_frame, tf_info.robot_footprint_frame, stamp)
-    if twist is not None and odom_stamp != 0.0 and odom_stamp != stamp:
+    then = history.at(odom_stamp) if (
+        history is not None and odom_stamp != 0.0 and odom_stamp != stamp) else None
+    if then is not None:
+        x, y, yaw = then
+    elif twist is not None and odom_stamp != 0.0 and odom_stamp != stamp:
         x, y, yaw = _move(x, y, yaw, twist, odom_stamp - stamp)
     t_yaw = normalize_angle(yaw - quaternion_to_yaw(qx, qy, qz, qw))
     c, s = math.cos(t_yaw), math.sin(t_yaw)
