@@ -484,6 +484,24 @@ class ScenarioRun:
                 return t, received
         return None
 
+    def sim_time_at_wall(self, wall: float) -> float | None:
+        """The playground's simulated time when the wall clock read ``wall``, interpolated
+        between the commands it received just before and after (the record pairs each with the
+        step that applied it; EasyNav republishes at least every 0.1 s), or None outside them.
+
+        Not ``wall × speed_up``: on a loaded machine the playground runs slower than its
+        nominal speed-up, and a wall-clock interval converted at the nominal rate spans more
+        simulated time than went by.
+        """
+        events = [(received, t) for t, _, _, received in self.record.get("commands", [])
+                  if received is not None]
+        before = [e for e in events if e[0] <= wall]
+        after = [e for e in events if e[0] > wall]
+        if not before or not after:
+            return None
+        (r0, t0), (r1, t1) = before[-1], after[0]
+        return t0 + (t1 - t0) * (wall - r0) / (r1 - r0)
+
     def pose_at(self, stamp: float) -> tuple[float, float]:
         """True position at the last recorded pose not after ``stamp`` (after the run)."""
         before = [(x, y) for t, x, y, _ in self.truth.true_poses if t <= stamp]
