@@ -57,9 +57,11 @@ def _cross(tmp_path, params, until_end: bool = True) -> tuple[ScenarioRun, tuple
         else:
             # A robot pushing against the person keeps it from walking on (it waits rather than
             # walk into the robot): stop at the first contact, or once its walk is long over.
+            # The wall-clock budget covers 60 s simulated at the speed-up, with a minute to
+            # spare for a playground that runs slower than that on a loaded machine.
             run.spin_until(
                 lambda: run.monitor.collision_count > 0 or run.sim_time() > 60.0,
-                timeout=60.0,
+                timeout=60.0 / speed_up() + 60.0,
                 what="a collision",
             )
             run.client.cancel()
