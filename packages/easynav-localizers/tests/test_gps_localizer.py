@@ -101,3 +101,57 @@ def test_last_known_pose_moves_the_estimate():
     assert (pose.x, pose.y) == pytest.approx((8.0, 8.0), abs=1e-3)
     assert pose.yaw == pytest.approx(1.0)
     assert math.isfinite(pose.x)
+
+
+def _drive(plugin, projection, fixes):
+    """Fixes ``(stamp, x, y)``; returns robot_pose's (x, y) after each (update after each)."""
+    nav_state = NavState()
+    seen = []
+    for stamp, x, y in fixes:
+        plugin.add_fix(_fix(projection, x, y, stamp, sigma=0.15))
+        plugin.update(nav_state)
+        pose = nav_state.get("robot_pose", Odometry).pose
+        seen.append((pose.x, pose.y))
+    return seen
+
+
+def test_a_fix_that_jumps_away_is_rejected_and_a_lasting_offset_is_taken():
+    """1 m/s east, a fix every 0.2 s; one fix 30 m off (a receiver's multipath jump) is
+    rejected: robot_pose stays on the way. Taken as the original took it, robot_pose moved 30 m
+    for a fix period. Six fixes in a row 10 m north of a standing robot (it was carried, or the
+    estimate was wrong; farther than 5 m/s could take it in 1.2 s): the first five are
+    rejected, then the offset is taken."""
+    projection = UtmProjection(*ORIGIN)
+    fixes = [(0.2 * k, 0.2 * k, 0.0) for k in range(10)]
+    fixes[5] = (1.0, 1.0 + 30.0, 0.0)
+    gated = _drive(_plugin(namespace="gps_test_gate"), projection, fixes)
+    assert max(abs(x - 0.2 * k) for k, (x, _) in enumerate(gated) if k != 5) < 1e-3
+    assert gated[5] == pytest.approx((0.8, 0.0), abs=1e-3)  # the last fix taken
+    original = _drive(_plugin({"fix_gate_speed": 0.0}, "gps_test_nogate"), projection, fixes)
+    assert original[5][0] == pytest.approx(31.0, abs=1e-3)
+
+    plugin = _plugin(namespace="gps_test_carried")
+    moved = [(0.2 * k, 0.0, 0.0) for k in range(5)] + [(1.0 + 0.2 * k, 0.0, 10.0)
+                                                       for k in range(6)]
+    seen = _drive(plugin, projection, moved)
+    assert all(y == pytest.approx(0.0, abs=1e-3) for _, y in seen[:10])
+    assert seen[10][1] == pytest.approx(10.0, abs=1e-3)
+    assert plugin.estimator.rejected_fixes == 5
+
+
+def test_map_to_odom_puts_the_tf_robot_at_the_estimate():
+    """odom -> robot says (1, 0) at the fix's time; the fix says (10, 5): map -> odom is the
+    difference, so map -> odom -> robot is the estimate. The original's static identity left
+    the TF tree's robot at the odometry's (1, 0)."""
+    from easynav.common.tf import get_tf_buffer
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin({"initial_pose.x": 10.0, "initial_pose.y": 5.0}, "gps_test_tf")
+    buffer = get_tf_buffer("gps_test_tf")
+    for stamp in (0.8, 1.0, 1.2):
+        buffer.set_transform_values("odom", "base_footprint", stamp,
+                                    (stamp, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), "test")
+    plugin.add_fix(_fix(projection, 0.0, 0.0, 1.0))
+    plugin.update(NavState())
+    _, (tx, ty, *_rest) = buffer.lookup_transform_values("map", "base_footprint", 1.0)
+    assert (tx, ty) == pytest.approx((10.0, 5.0), abs=1e-6)

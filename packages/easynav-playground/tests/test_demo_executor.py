@@ -67,8 +67,9 @@ def test_the_monitor_and_the_goal_client_take_messages_on_it():
 
 
 def test_a_localizer_outside_tf_is_scored_from_its_estimate_topic():
-    """The GpsLocalizer broadcasts an identity map -> odom: the monitor records the pose it
-    publishes, not odometry composed with that identity (which would score the odometry)."""
+    """A localizer scored from its topic (the GpsLocalizer: the original's broadcast an
+    identity map -> odom): the monitor records the pose it publishes, not odometry composed
+    with whatever map -> odom TF holds."""
     from nav_msgs.msg import Odometry
     from tf2_msgs.msg import TFMessage
 

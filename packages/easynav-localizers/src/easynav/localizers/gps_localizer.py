@@ -16,12 +16,11 @@ from easynav.core.types import (
     Header,
     Odometry,
     Pose,
-    Transform,
-    TransformStamped,
     Twist,
 )
 from easynav.core.warning_throttle import WarningThrottle
 from easynav.localizers.gps.gps_pose_estimator import GpsPoseEstimator
+from easynav.localizers.map_to_odom import map_to_odom
 
 #: The original's fixed topics (relative; not parameters, not through the sensors node).
 FIX_TOPIC = "robot/gps/fix"
@@ -52,8 +51,10 @@ class GpsLocalizer(LocalizerMethodBase):
 
     NavState: writes ``robot_pose`` in ``update`` (non-RT; ``update_rt`` does nothing, as the
     original). ROS: subscribes ``robot/gps/fix`` (NavSatFix) and ``imu/data`` (Imu) with
-    sensor-data QoS made reliable; publishes ``robot/odom_gps`` (Odometry); broadcasts a static
-    identity ``map → odom``; ``initialpose`` moves the estimate (later fixes shifted to agree).
+    sensor-data QoS made reliable; publishes ``robot/odom_gps`` (Odometry); broadcasts
+    ``map → odom`` from the estimate (the original: a static identity); ``initialpose`` moves
+    the estimate (later fixes shifted to agree). Fixes that jump away from the estimate are
+    rejected (``fix_gate_speed``; not in the original).
     Without ROS, :meth:`add_fix` and :meth:`add_imu` feed it.
 
     Thread contract: subscription callbacks and ``update`` on the non-RT side; one lock guards
@@ -71,6 +72,10 @@ class GpsLocalizer(LocalizerMethodBase):
         Param("initial_pose.y", 0.0, "where the first fix lands: y (map frame)", "m", **_STATIC),
         Param("initial_pose.yaw", 0.0, "unused (yaw comes from the IMU), as the original", "rad",
               **_STATIC),
+        Param("fix_gate_speed", 5.0,
+              "a fix farther than this speed times the time since the last fix taken (plus 5 "
+              "sigma of its noise) is rejected as a jump, unless 5 in a row are; 0: every fix "
+              "is taken (the original)", "m/s", ge=0.0, **_STATIC),
     )
     TOPICS = LocalizerMethodBase.TOPICS + (
         Topic(FIX_TOPIC, "sensor_msgs/msg/NavSatFix", "sub", "sensor data, reliable",
@@ -78,7 +83,8 @@ class GpsLocalizer(LocalizerMethodBase):
         Topic(IMU_TOPIC, "sensor_msgs/msg/Imu", "sub", "sensor data, reliable",
               "orientation and gyro"),
         Topic(ODOM_TOPIC, "nav_msgs/msg/Odometry", "pub", description="the estimate"),
-        Topic("tf_static", "tf2_msgs/msg/TFMessage", "pub", description="map → odom identity"),
+        Topic("/tf", "tf2_msgs/msg/TFMessage", "pub",
+              description="map → odom from the estimate (the original: a static identity)"),
     )
     WRITES = (ROBOT_POSE,)
 
@@ -88,17 +94,18 @@ class GpsLocalizer(LocalizerMethodBase):
         self._throttle = WarningThrottle(period=5.0)
         self.estimator = GpsPoseEstimator()
         self._ros: dict[str, Any] = {}
-        self._static = None
+        self._broadcaster = None
+        self._reported_rejections = 0
 
     def on_initialize(self) -> None:
         self._destroy_ros()
         v = self.params
         with self._lock:
-            self.estimator = GpsPoseEstimator(v["initial_pose.x"], v["initial_pose.y"])
+            self.estimator = GpsPoseEstimator(v["initial_pose.x"], v["initial_pose.y"],
+                                              gate_speed=v.fix_gate_speed)
+            self._reported_rejections = 0
         if self.context.node is not None:
             self._create_ros()
-        else:
-            self._send_identity()
 
     def on_cleanup(self) -> None:
         self._destroy_ros()
@@ -127,12 +134,20 @@ class GpsLocalizer(LocalizerMethodBase):
         """Nothing (the original's ``update_rt`` is empty)."""
 
     def update(self, nav_state: NavState) -> None:
-        """Write ``robot_pose`` from the last fix and IMU reading (once a fix arrived)."""
+        """Write ``robot_pose`` from the last fix and IMU reading (once a fix arrived) and
+        broadcast ``map → odom`` from it."""
         with self._lock:
             e = self.estimator
             if e.position is None:
                 self._throttle.warn(self.logger, "no-fix", f"{self.plugin_name}: no GNSS fix yet")
                 return
+            if e.rejected_fixes > self._reported_rejections:
+                self._reported_rejections = e.rejected_fixes
+                self._throttle.warn(self.logger, "jump",
+                                    f"{self.plugin_name}: a fix jumped away from the estimate: "
+                                    f"rejected ({e.rejected_fixes} so far; fix_gate_speed "
+                                    f"{e.gate_speed:g} m/s)")
+            anchor = (float(e.position[0]), float(e.position[1]), e.yaw, e.fix_stamp)
             qx, qy, qz, qw = _rpy_quaternion(e.roll, e.pitch, e.yaw)
             tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
             odometry = Odometry(
@@ -144,21 +159,33 @@ class GpsLocalizer(LocalizerMethodBase):
                             wz=e.angular_velocity[2]),
             )
         nav_state.set(ROBOT_POSE, odometry)
+        self._send_map_to_odom(*anchor)
         publisher = self._ros.get("odom")
         if publisher is not None:
             from easynav.system.ros.converters import odometry_to_msg
 
             publisher.publish(odometry_to_msg(odometry))
 
-    # -- ROS -----------------------------------------------------------------------------------
-    def _identity(self) -> TransformStamped:
-        tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
-        return TransformStamped(Header(0.0, tf_info.map_frame), tf_info.odom_frame,
-                                Transform(np.zeros(3), np.array((0.0, 0.0, 0.0, 1.0))))
+    def _send_map_to_odom(self, x: float, y: float, yaw: float, stamp: float) -> None:
+        """``map → odom`` that puts the robot at the estimate: the fix's position with
+        ``odom → robot`` at the fix's stamp. The original broadcast a static identity, which
+        put the TF tree's robot at the wheel odometry's pose: after a few minutes of wheel slip
+        that was metres from ``robot_pose``, and every perception fused into the map frame (the
+        maps managers' obstacles) landed there (on the campus, walls drawn across the way to
+        a waypoint: no path)."""
+        buffer = get_tf_buffer(self.context.namespace)
+        try:
+            transform = map_to_odom(buffer, x, y, yaw, stamp)
+        except LookupError as exc:  # no odometry transform (yet): nothing to anchor it on
+            self._throttle.warn(self.logger, "no-odom-tf",
+                                f"{self.plugin_name}: no map → odom: {exc}")
+            return
+        if self._broadcaster is not None:
+            self._broadcaster.send_transform(transform)
+        else:
+            buffer.set_transform(transform, self.plugin_name)
 
-    def _send_identity(self) -> None:
-        get_tf_buffer(self.context.namespace).set_transform(self._identity(), self.plugin_name,
-                                                            is_static=True)
+    # -- ROS -----------------------------------------------------------------------------------
 
     def _create_ros(self) -> None:
         from nav_msgs.msg import Odometry as OdometryMsg
@@ -167,7 +194,7 @@ class GpsLocalizer(LocalizerMethodBase):
 
         from easynav.system.sensors.converters.imu import imu_from_msg
         from easynav.system.sensors.converters.nav_sat_fix import gnss_from_msg
-        from easynav.system.tf import StaticTFBroadcaster
+        from easynav.system.tf import TFBroadcaster
 
         node = self.context.node
         qos = qos_profile_sensor_data
@@ -193,13 +220,13 @@ class GpsLocalizer(LocalizerMethodBase):
             "imu": node.create_subscription(Imu, IMU_TOPIC, on_imu, qos),
             "odom": node.create_publisher(OdometryMsg, ODOM_TOPIC, 10),
         }
-        self._static = StaticTFBroadcaster(node, local_buffer=get_tf_buffer(self.context.namespace))
-        self._static.send_transform(self._identity())
+        self._broadcaster = TFBroadcaster(node,
+                                          local_buffer=get_tf_buffer(self.context.namespace))
 
     def _destroy_ros(self) -> None:
         node = self.context.node
         ros, self._ros = self._ros, {}
-        static, self._static = self._static, None
+        broadcaster, self._broadcaster = self._broadcaster, None
         if node is None:
             return
         for name, entity in ros.items():
@@ -207,5 +234,5 @@ class GpsLocalizer(LocalizerMethodBase):
                 node.destroy_publisher(entity)
             else:
                 node.destroy_subscription(entity)
-        if static is not None and hasattr(static, "destroy"):
-            static.destroy()
+        if broadcaster is not None:
+            broadcaster.destroy()

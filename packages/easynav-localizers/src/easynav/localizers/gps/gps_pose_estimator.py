@@ -15,6 +15,11 @@ from easynav.localizers.fusion.utm_projection import UtmProjection
 GYRO_WEIGHT = 0.99
 #: Variance of a position whose fix has no covariance, and of an IMU yaw without one.
 UNKNOWN_VARIANCE = 1.0
+#: Rejected fixes in a row after which the next one is taken whatever its distance: an offset
+#: that persists is real (the robot was carried, or the estimate was the wrong one).
+GATE_RELEASE = 5
+#: Standard deviations of a fix's own noise allowed beyond the way the robot can have driven.
+GATE_SIGMAS = 5.0
 
 
 def _wrap(a: float) -> float:
@@ -32,11 +37,22 @@ class GpsPoseEstimator:
       gyro bias); here the filtered yaw is the integrator's state. Its variance follows the same
       recursion, ``σ² ← 0.99²·(σ² + σ_ω²·dt²) + 0.01²·σ²_IMU``. Roll and pitch are the IMU's.
 
+    - Jump gate (not in the original): with ``gate_speed`` > 0, a fix farther from the
+      estimate than ``gate_speed`` times the time since the last fix taken, plus
+      :data:`GATE_SIGMAS` standard deviations of its own noise, is rejected (a receiver's
+      multipath jump: one fix 30 m off moved ``robot_pose`` 30 m for a fix period), unless
+      :data:`GATE_RELEASE` fixes in a row were. ``rejected_fixes`` counts them.
+
     Raises ImportError naming the extra without pyproj. Thread contract: none (the plugin
     serialises calls).
     """
 
-    def __init__(self, x0: float = 0.0, y0: float = 0.0, yaw0: float = 0.0) -> None:
+    def __init__(self, x0: float = 0.0, y0: float = 0.0, yaw0: float = 0.0,
+                 gate_speed: float = 0.0) -> None:
+        self.gate_speed = float(gate_speed)
+        self.rejected_fixes = 0
+        self._rejected_in_a_row = 0
+        self.fix_stamp = 0.0
         self.offset = np.array((x0, y0))
         self.projection: UtmProjection | None = None
         self.position: np.ndarray | None = None
@@ -51,22 +67,38 @@ class GpsPoseEstimator:
         self.stamp = 0.0
 
     def add_fix(self, fix: GNSSPerception) -> bool:
-        """Take a fix; False when it has none (ignored)."""
+        """Take a fix; False when it has none (ignored) or the jump gate rejects it."""
         if not fix.has_fix:
             return False
         if self.projection is None:
             self.projection = UtmProjection(fix.latitude, fix.longitude, fix.altitude)
         east, north = self.projection.forward(fix.latitude, fix.longitude)
-        self.position = np.array((east, north)) + self.offset
+        position = np.array((east, north)) + self.offset
         cov = np.asarray(fix.position_covariance, dtype=float).reshape(3, 3)
         if fix.position_covariance_type >= COVARIANCE_TYPE_DIAGONAL_KNOWN and np.all(
             np.isfinite(cov)
         ):
-            self.position_covariance = cov[:2, :2].copy()
+            covariance = cov[:2, :2].copy()
         else:
-            self.position_covariance = np.eye(2) * UNKNOWN_VARIANCE
+            covariance = np.eye(2) * UNKNOWN_VARIANCE
+        if self._jumps(position, covariance, fix.stamp):
+            self.rejected_fixes += 1
+            self._rejected_in_a_row += 1
+            return False
+        self._rejected_in_a_row = 0
+        self.position, self.position_covariance = position, covariance
+        self.fix_stamp = max(self.fix_stamp, fix.stamp)
         self.stamp = max(self.stamp, fix.stamp)
         return True
+
+    def _jumps(self, position: np.ndarray, covariance: np.ndarray, stamp: float) -> bool:
+        if (self.gate_speed <= 0.0 or self.position is None
+                or self._rejected_in_a_row >= GATE_RELEASE):
+            return False
+        elapsed = max(stamp - self.fix_stamp, 0.0)
+        sigma = math.sqrt(max(float(np.max(np.diag(covariance))), 0.0))
+        reach = self.gate_speed * elapsed + GATE_SIGMAS * sigma
+        return float(np.hypot(*(position - self.position))) > reach
 
     def add_imu(self, imu: ImuPerception) -> None:
         """Take an IMU reading: roll and pitch, and one step of the yaw filter."""

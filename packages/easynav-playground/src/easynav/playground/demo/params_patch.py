@@ -20,8 +20,9 @@ VOXEL_MAPS_MANAGERS = {
     "easynav_octomap_maps_manager/OctomapMapsManager": "octomap_path_file",
     "easynav_bonxai_maps_manager/BonxaiMapsManager": "bonxai_path_file",
 }
-#: Localizers whose estimate is not in TF, and the Odometry topic (map frame) it is published
-#: on: the GpsLocalizer broadcasts an identity ``map -> odom``, as the original's does.
+#: Localizers scored from the Odometry topic (map frame) they publish rather than from TF: the
+#: original's GpsLocalizer broadcast an identity ``map -> odom`` (TF scored the odometry); ours
+#: follows its estimate, but only at each fix, so its own topic is still the estimate itself.
 ESTIMATE_TOPICS = {"easynav_gps_localizer/GpsLocalizer": "/robot/odom_gps"}
 
 
