@@ -139,19 +139,60 @@ def test_a_fix_that_jumps_away_is_rejected_and_a_lasting_offset_is_taken():
     assert plugin.estimator.rejected_fixes == 5
 
 
-def test_map_to_odom_puts_the_tf_robot_at_the_estimate():
-    """odom -> robot says (1, 0) at the fix's time; the fix says (10, 5): map -> odom is the
-    difference, so map -> odom -> robot is the estimate. The original's static identity left
-    the TF tree's robot at the odometry's (1, 0)."""
+def test_map_to_odom_puts_the_tf_robot_at_the_estimate_and_odometry_carries_it_on():
+    """odom -> robot drives 1 m/s along odom's x (x = t); the fix of t = 1 says (10, 5) and
+    the IMU, at t = 1, that the robot faces 0.5 rad (odometry says 0). map -> odom is computed
+    once for that fix, so that map -> odom -> robot is the estimate at the fix's time, and
+    re-sent stamped with the newest odometry: the TF tree's robot moves on with odometry
+    between fixes and through an outage (no fix from t = 1 to 3). The original's static
+    identity left it at the odometry's pose, (1, 0) and then (3, 0)."""
     from easynav.common.tf import get_tf_buffer
 
     projection = UtmProjection(*ORIGIN)
     plugin = _plugin({"initial_pose.x": 10.0, "initial_pose.y": 5.0}, "gps_test_tf")
     buffer = get_tf_buffer("gps_test_tf")
-    for stamp in (0.8, 1.0, 1.2):
-        buffer.set_transform_values("odom", "base_footprint", stamp,
-                                    (stamp, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), "test")
+
+    def odometry(until: float) -> None:
+        for k in range(round(until / 0.1) - 2, round(until / 0.1) + 1):
+            buffer.set_transform_values("odom", "base_footprint", k * 0.1,
+                                        (k * 0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), "test")
+
+    odometry(1.2)
+    plugin.add_imu(_imu(0.5, 0.0, 1.0))
     plugin.add_fix(_fix(projection, 0.0, 0.0, 1.0))
     plugin.update(NavState())
-    _, (tx, ty, *_rest) = buffer.lookup_transform_values("map", "base_footprint", 1.0)
-    assert (tx, ty) == pytest.approx((10.0, 5.0), abs=1e-6)
+    stamp, (tx, ty, *_r, qz, qw) = buffer.lookup_transform_values("map", "base_footprint")
+    assert stamp == pytest.approx(1.2)  # map -> odom stamped with the newest odometry
+    # At t = 1.2: the fix's (10, 5), then 0.2 m on along the IMU's heading.
+    assert (tx, ty) == pytest.approx((10.0 + 0.2 * math.cos(0.5), 5.0 + 0.2 * math.sin(0.5)))
+    assert 2.0 * math.atan2(qz, qw) == pytest.approx(0.5, abs=1e-6)
+    odometry(3.0)  # an outage: odometry only
+    plugin.update(NavState())
+    stamp, (tx, ty, *_r) = buffer.lookup_transform_values("map", "base_footprint")
+    assert stamp == pytest.approx(3.0)
+    assert (tx, ty) == pytest.approx((10.0 + 2.0 * math.cos(0.5), 5.0 + 2.0 * math.sin(0.5)))
+
+
+def test_gate_edge_cases():
+    """An unstamped fix is not gated (the time since the last one is unknown); one older than
+    the last fix taken is dropped; a handover (on_last_known_pose) starts the count of
+    rejections in a row again."""
+    from easynav.core.types import Header, Pose
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace="gps_test_edges")
+    estimator = plugin.estimator
+    assert plugin.add_fix(_fix(projection, 0.0, 0.0, 1.0)) is None
+    estimator_position = estimator.position.copy()
+    plugin.add_fix(_fix(projection, 8.0, 0.0, 0.0))  # unstamped, 8 m away: taken
+    assert estimator.position[0] == pytest.approx(estimator_position[0] + 8.0, abs=1e-3)
+    plugin.add_fix(_fix(projection, 8.5, 0.0, 0.5))  # older than the last fix taken (1.0)
+    assert estimator.position[0] == pytest.approx(8.0, abs=1e-3)
+    for k in range(3):
+        plugin.add_fix(_fix(projection, 50.0, 0.0, 1.2 + 0.2 * k))  # rejected, 3 in a row
+    plugin.on_last_known_pose(Odometry(header=Header(1.8, "map"),
+                                       pose=Pose.from_xy_yaw(8.0, 0.0, 0.0)))
+    plugin.add_fix(_fix(projection, 50.0, 0.0, 1.8))
+    plugin.add_fix(_fix(projection, 50.0, 0.0, 2.0))
+    assert estimator.position[0] == pytest.approx(8.0, abs=1e-3)  # still rejected
+    assert estimator.rejected_fixes == 5 and estimator.released_jumps == 0

@@ -240,8 +240,8 @@ def test_the_controller_cycle_is_read_from_easynavs_log(tmp_path):
 
 
 def test_the_gps_localizers_estimate_is_read_from_its_topic(tmp_path):
-    """Its map -> odom is a static identity (as the original's): the demo scores the pose it
-    publishes on robot/odom_gps; every other localizer is read from TF."""
+    """The demo scores the pose the GpsLocalizer publishes on robot/odom_gps (the original's
+    map -> odom was a static identity); every other localizer is read from TF."""
     params = tmp_path / "p.yaml"
     gps = {"plugin": "easynav_gps_localizer/GpsLocalizer"}
     localizer = {"localizer_types": ["gps"], "gps": gps}

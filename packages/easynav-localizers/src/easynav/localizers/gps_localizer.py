@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import threading
 from typing import Any, ClassVar
 
@@ -16,11 +17,15 @@ from easynav.core.types import (
     Header,
     Odometry,
     Pose,
+    Transform,
+    TransformStamped,
     Twist,
+    normalize_angle,
+    quaternion_to_yaw,
+    yaw_to_quaternion,
 )
 from easynav.core.warning_throttle import WarningThrottle
-from easynav.localizers.gps.gps_pose_estimator import GpsPoseEstimator
-from easynav.localizers.map_to_odom import map_to_odom
+from easynav.localizers.gps.gps_pose_estimator import GATE_RELEASE, GpsPoseEstimator
 
 #: The original's fixed topics (relative; not parameters, not through the sensors node).
 FIX_TOPIC = "robot/gps/fix"
@@ -96,6 +101,10 @@ class GpsLocalizer(LocalizerMethodBase):
         self._ros: dict[str, Any] = {}
         self._broadcaster = None
         self._reported_rejections = 0
+        self._reported_releases = 0
+        #: map → odom as of the last fix anchored: (fix stamp, tx, ty, yaw).
+        self._anchor: tuple[float, float, float, float] | None = None
+        self._sent_stamp = -math.inf
 
     def on_initialize(self) -> None:
         self._destroy_ros()
@@ -103,7 +112,8 @@ class GpsLocalizer(LocalizerMethodBase):
         with self._lock:
             self.estimator = GpsPoseEstimator(v["initial_pose.x"], v["initial_pose.y"],
                                               gate_speed=v.fix_gate_speed)
-            self._reported_rejections = 0
+            self._reported_rejections = self._reported_releases = 0
+            self._anchor, self._sent_stamp = None, -math.inf
         if self.context.node is not None:
             self._create_ros()
 
@@ -128,6 +138,7 @@ class GpsLocalizer(LocalizerMethodBase):
         """Continue from ``pose``: later fixes are shifted so it holds."""
         with self._lock:
             self.estimator.reset(pose.pose.x, pose.pose.y, pose.pose.yaw)
+            self._anchor = None  # anchored again at the next update
 
     # -- cycle ---------------------------------------------------------------------------------
     def update_rt(self, nav_state: NavState) -> None:
@@ -141,13 +152,8 @@ class GpsLocalizer(LocalizerMethodBase):
             if e.position is None:
                 self._throttle.warn(self.logger, "no-fix", f"{self.plugin_name}: no GNSS fix yet")
                 return
-            if e.rejected_fixes > self._reported_rejections:
-                self._reported_rejections = e.rejected_fixes
-                self._throttle.warn(self.logger, "jump",
-                                    f"{self.plugin_name}: a fix jumped away from the estimate: "
-                                    f"rejected ({e.rejected_fixes} so far; fix_gate_speed "
-                                    f"{e.gate_speed:g} m/s)")
-            anchor = (float(e.position[0]), float(e.position[1]), e.yaw, e.fix_stamp)
+            self._report_gate(e)
+            fix = (float(e.position[0]), float(e.position[1]), e.fix_stamp, e.yaw, e.imu_stamp)
             qx, qy, qz, qw = _rpy_quaternion(e.roll, e.pitch, e.yaw)
             tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
             odometry = Odometry(
@@ -159,27 +165,66 @@ class GpsLocalizer(LocalizerMethodBase):
                             wz=e.angular_velocity[2]),
             )
         nav_state.set(ROBOT_POSE, odometry)
-        self._send_map_to_odom(*anchor)
+        self._send_map_to_odom(*fix)
         publisher = self._ros.get("odom")
         if publisher is not None:
             from easynav.system.ros.converters import odometry_to_msg
 
             publisher.publish(odometry_to_msg(odometry))
 
-    def _send_map_to_odom(self, x: float, y: float, yaw: float, stamp: float) -> None:
-        """``map → odom`` that puts the robot at the estimate: the fix's position with
-        ``odom → robot`` at the fix's stamp. The original broadcast a static identity, which
-        put the TF tree's robot at the wheel odometry's pose: after a few minutes of wheel slip
-        that was metres from ``robot_pose``, and every perception fused into the map frame (the
-        maps managers' obstacles) landed there (on the campus, walls drawn across the way to
-        a waypoint: no path)."""
+    def _report_gate(self, e: GpsPoseEstimator) -> None:
+        """Throttled warnings for the fixes the jump gate rejected, and for a far fix taken
+        after it rejected enough in a row. Under the lock."""
+        if e.rejected_fixes > self._reported_rejections:
+            self._reported_rejections = e.rejected_fixes
+            self._throttle.warn(self.logger, "jump",
+                                f"{self.plugin_name}: a fix jumped away from the estimate: "
+                                f"rejected ({e.rejected_fixes} so far; fix_gate_speed "
+                                f"{e.gate_speed:g} m/s)")
+        if e.released_jumps > self._reported_releases:
+            self._reported_releases = e.released_jumps
+            self._throttle.warn(self.logger, "release",
+                                f"{self.plugin_name}: the fixes stayed away from the estimate "
+                                f"for {GATE_RELEASE} in a row: the estimate moves to them")
+
+    def _send_map_to_odom(self, x: float, y: float, fix_stamp: float, yaw: float,
+                          yaw_stamp: float | None) -> None:
+        """``map → odom`` that puts the robot at the estimate: computed once per fix (its
+        position with ``odom → robot`` at its stamp; the rotation from the IMU filter's yaw
+        with ``odom → robot``'s yaw at that yaw's stamp), then re-sent stamped with the newest
+        ``odom → robot``, so that between fixes and through an outage the TF tree's robot
+        moves with odometry from the last fix.
+
+        The original broadcast a static identity, which put the TF tree's robot at the wheel
+        odometry's pose: after a few minutes of wheel slip that was metres from
+        ``robot_pose``, and what the maps managers fuse into the map frame from the robot's
+        sensors landed there (on the campus, walls drawn across the way to a waypoint: no
+        path)."""
         buffer = get_tf_buffer(self.context.namespace)
+        tf_info = buffer.get_tf_info()
+        odom, robot = tf_info.odom_frame, tf_info.robot_footprint_frame
         try:
-            transform = map_to_odom(buffer, x, y, yaw, stamp)
+            newest, _ = buffer.lookup_transform_values(odom, robot)
+            if self._anchor is None or (self._anchor[0] != fix_stamp and newest >= fix_stamp):
+                _, (ox, oy, _, *q) = buffer.lookup_transform_values_near(odom, robot, fix_stamp)
+                turn = quaternion_to_yaw(*q)
+                if yaw_stamp is not None:
+                    turn = quaternion_to_yaw(*buffer.lookup_transform_values_near(
+                        odom, robot, yaw_stamp)[1][3:])
+                t_yaw = normalize_angle(yaw - turn)
+                c, s = math.cos(t_yaw), math.sin(t_yaw)
+                self._anchor = (fix_stamp, x - (c * ox - s * oy), y - (s * ox + c * oy), t_yaw)
         except LookupError as exc:  # no odometry transform (yet): nothing to anchor it on
             self._throttle.warn(self.logger, "no-odom-tf",
                                 f"{self.plugin_name}: no map → odom: {exc}")
             return
+        stamp = max(fix_stamp, newest)
+        if self._anchor is None or stamp <= self._sent_stamp:
+            return  # nothing newer to say (a repeated stamp is TF_REPEATED_DATA for tf2)
+        self._sent_stamp = stamp
+        _, tx, ty, t_yaw = self._anchor
+        transform = TransformStamped(Header(stamp, tf_info.map_frame), odom, Transform(
+            np.array((tx, ty, 0.0)), np.array(yaw_to_quaternion(t_yaw))))
         if self._broadcaster is not None:
             self._broadcaster.send_transform(transform)
         else:

@@ -41,7 +41,9 @@ class GpsPoseEstimator:
       estimate than ``gate_speed`` times the time since the last fix taken, plus
       :data:`GATE_SIGMAS` standard deviations of its own noise, is rejected (a receiver's
       multipath jump: one fix 30 m off moved ``robot_pose`` 30 m for a fix period), unless
-      :data:`GATE_RELEASE` fixes in a row were. ``rejected_fixes`` counts them.
+      :data:`GATE_RELEASE` fixes in a row were (``released_jumps`` counts the far fixes taken
+      so). ``rejected_fixes`` counts the rejected ones. An unstamped fix (0) is not gated (the
+      time since the last one is unknown); one older than the last fix taken is dropped.
 
     Raises ImportError naming the extra without pyproj. Thread contract: none (the plugin
     serialises calls).
@@ -51,6 +53,7 @@ class GpsPoseEstimator:
                  gate_speed: float = 0.0) -> None:
         self.gate_speed = float(gate_speed)
         self.rejected_fixes = 0
+        self.released_jumps = 0
         self._rejected_in_a_row = 0
         self.fix_stamp = 0.0
         self.offset = np.array((x0, y0))
@@ -68,7 +71,7 @@ class GpsPoseEstimator:
 
     def add_fix(self, fix: GNSSPerception) -> bool:
         """Take a fix; False when it has none (ignored) or the jump gate rejects it."""
-        if not fix.has_fix:
+        if not fix.has_fix or 0.0 < fix.stamp < self.fix_stamp:
             return False
         if self.projection is None:
             self.projection = UtmProjection(fix.latitude, fix.longitude, fix.altitude)
@@ -82,9 +85,11 @@ class GpsPoseEstimator:
         else:
             covariance = np.eye(2) * UNKNOWN_VARIANCE
         if self._jumps(position, covariance, fix.stamp):
-            self.rejected_fixes += 1
-            self._rejected_in_a_row += 1
-            return False
+            if self._rejected_in_a_row < GATE_RELEASE:
+                self.rejected_fixes += 1
+                self._rejected_in_a_row += 1
+                return False
+            self.released_jumps += 1  # the offset lasted: taken
         self._rejected_in_a_row = 0
         self.position, self.position_covariance = position, covariance
         self.fix_stamp = max(self.fix_stamp, fix.stamp)
@@ -92,8 +97,8 @@ class GpsPoseEstimator:
         return True
 
     def _jumps(self, position: np.ndarray, covariance: np.ndarray, stamp: float) -> bool:
-        if (self.gate_speed <= 0.0 or self.position is None
-                or self._rejected_in_a_row >= GATE_RELEASE):
+        """Whether a fix at ``position`` is farther than the gate allows."""
+        if self.gate_speed <= 0.0 or self.position is None or stamp <= 0.0:
             return False
         elapsed = max(stamp - self.fix_stamp, 0.0)
         sigma = math.sqrt(max(float(np.max(np.diag(covariance))), 0.0))
@@ -128,8 +133,14 @@ class GpsPoseEstimator:
             self.yaw_variance = g * g * variance + (1.0 - g) ** 2 * var_imu
         self.stamp = max(self.stamp, imu.stamp)
 
+    @property
+    def imu_stamp(self) -> float | None:
+        """Stamp of the last IMU reading (the time :attr:`yaw` is of), None before one."""
+        return self._imu_stamp
+
     def reset(self, x: float, y: float, yaw: float) -> None:
         """Move the estimate to ``(x, y, yaw)``: later fixes are shifted to agree."""
+        self._rejected_in_a_row = 0
         if self.position is not None:
             self.offset += np.array((x, y)) - self.position
             self.position = np.array((x, y))

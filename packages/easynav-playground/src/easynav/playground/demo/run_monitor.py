@@ -45,8 +45,9 @@ class RunMonitor(Node):
       base_footprint`` (from the playground) gives EasyNav's pose estimate at each odometry
       stamp, recorded in :attr:`estimates` for the localisation error;
     - ``estimate_topic`` instead, when given: the localizer's pose (an Odometry in the map
-      frame) for a localizer whose estimate is not in TF (the GpsLocalizer's map -> odom is a
-      static identity: composing it with odometry would score the odometry, not the estimate);
+      frame) for a localizer scored from its own topic (the GpsLocalizer: the original's
+      map -> odom was a static identity, and composing it with odometry scored the odometry;
+      ours follows the fixes, and its topic is still the estimate itself);
     - with a ``frame_prefix`` (one robot of several, the node in the robot's namespace): its
       own ``tf`` (``/r1/tf``) instead, the frames prefixed (``r1/map``...), and every frame
       seen there without the prefix is kept in :attr:`foreign_frames` (a crossed tree);
