@@ -192,7 +192,74 @@ def test_gate_edge_cases():
         plugin.add_fix(_fix(projection, 50.0, 0.0, 1.2 + 0.2 * k))  # rejected, 3 in a row
     plugin.on_last_known_pose(Odometry(header=Header(1.8, "map"),
                                        pose=Pose.from_xy_yaw(8.0, 0.0, 0.0)))
-    plugin.add_fix(_fix(projection, 50.0, 0.0, 1.8))
-    plugin.add_fix(_fix(projection, 50.0, 0.0, 2.0))
-    assert estimator.position[0] == pytest.approx(8.0, abs=1e-3)  # still rejected
-    assert estimator.rejected_fixes == 5 and estimator.released_jumps == 0
+    for k in range(5):  # the count starts again: five more rejected...
+        plugin.add_fix(_fix(projection, 50.0, 0.0, 2.0 + 0.2 * k))
+        assert estimator.position[0] == pytest.approx(8.0, abs=1e-3)
+    plugin.add_fix(_fix(projection, 50.0, 0.0, 3.0))  # ... and the sixth is taken
+    assert estimator.position[0] == pytest.approx(50.0, abs=1e-3)
+    assert estimator.rejected_fixes == 8 and estimator.released_jumps == 1
+
+
+def test_a_clock_that_goes_back_starts_a_new_time_line():
+    """A simulator restarted: fixes stamped from 0 again after 20 s. Dropped as out of order,
+    the estimate stood at the last fix of the old time line for good."""
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace="gps_test_clock")
+    for k in range(1, 21):
+        plugin.add_fix(_fix(projection, 0.5 * k, 0.0, float(k)))
+    plugin.add_fix(_fix(projection, 3.0, 0.0, 19.5))  # out of order by 0.5 s: dropped
+    assert plugin.estimator.position[0] == pytest.approx(9.5, abs=1e-3)  # from the first fix
+    for k in range(1, 4):  # the new time line, the robot put back near the start
+        plugin.add_fix(_fix(projection, 0.3 * k, 0.0, 0.2 * k))
+    assert plugin.estimator.position[0] == pytest.approx(0.9 - 0.5, abs=1e-3)
+
+
+def _odometry_line(buffer, stamps, yaw_rate=0.0):
+    """odom -> robot at ``stamps``: 1 m/s along odom's x, turning at ``yaw_rate`` on the spot
+    (the position stays on the line: a test of the yaw alone)."""
+    for t in stamps:
+        buffer.set_transform_values("odom", "base_footprint", t,
+                                    (t, 0.0, 0.0, *yaw_to_quaternion(yaw_rate * t)), "test")
+
+
+def test_the_anchor_pairs_the_imu_yaw_with_odometry_at_one_instant():
+    """Turning at 1 rad/s; the IMU reading (t = 1.3) is ahead of the newest odometry (1.2):
+    its yaw is moved back by the gyro to 1.2 before it is paired with odometry's yaw there.
+    Paired with odometry of 0.1 s before, map -> odom's rotation was 0.1 rad off."""
+    from easynav.common.tf import get_tf_buffer
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace="gps_test_yaw_pair")
+    buffer = get_tf_buffer("gps_test_yaw_pair")
+    _odometry_line(buffer, [0.8, 0.9, 1.0, 1.1, 1.2], yaw_rate=1.0)
+    plugin.add_imu(_imu(1.3, 1.0, 1.3))  # the IMU says 1.3 rad at t = 1.3: odometry agrees
+    plugin.add_fix(_fix(projection, 0.0, 0.0, 1.0))
+    plugin.update(NavState())
+    _, (*_r, qz, qw) = buffer.lookup_transform_values("map", "odom")
+    assert 2.0 * math.atan2(qz, qw) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_handover_between_fixes_leaves_no_bias():
+    """The last fix at t = 1 (x = 1, the robot at 1 m/s); a handover at t = 1.8 puts the robot
+    where it truly is, x = 1.8. The next fixes (x = t) land on the robot: the shift compares
+    the handover with the estimate at t = 1.8 (the last fix moved on by odometry). Compared
+    with the last fix itself, the 0.8 m driven since stayed as a bias."""
+    from easynav.common.tf import get_tf_buffer
+    from easynav.core.types import Header, Pose
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace="gps_test_handover")
+    buffer = get_tf_buffer("gps_test_handover")
+    _odometry_line(buffer, [0.1 * k for k in range(0, 25)])
+    plugin.add_fix(_fix(projection, 0.0, 0.0, 0.0))
+    for t in (0.5, 1.0):
+        plugin.add_fix(_fix(projection, t, 0.0, t))
+        plugin.update(NavState())
+    plugin.on_last_known_pose(Odometry(header=Header(1.8, "map"),
+                                       pose=Pose.from_xy_yaw(1.8, 0.0, 0.0)))
+    plugin.add_fix(_fix(projection, 2.0, 0.0, 2.0))
+    nav_state = NavState()
+    plugin.update(nav_state)
+    assert nav_state.get("robot_pose", Odometry).pose.x == pytest.approx(2.0, abs=1e-3)
+    _, (tx, *_r) = buffer.lookup_transform_values("map", "base_footprint")  # t = 2.4
+    assert tx == pytest.approx(2.4, abs=1e-3)

@@ -25,7 +25,11 @@ from easynav.core.types import (
     yaw_to_quaternion,
 )
 from easynav.core.warning_throttle import WarningThrottle
-from easynav.localizers.gps.gps_pose_estimator import GATE_RELEASE, GpsPoseEstimator
+from easynav.localizers.gps.gps_pose_estimator import (
+    CLOCK_JUMP,
+    GATE_RELEASE,
+    GpsPoseEstimator,
+)
 
 #: The original's fixed topics (relative; not parameters, not through the sensors node).
 FIX_TOPIC = "robot/gps/fix"
@@ -43,6 +47,29 @@ def _rpy_quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float
     cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
     return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
             cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+#: How long (s) a fix ahead of the newest ``odom → robot`` waits for odometry before
+#: ``map → odom`` is anchored on the latest odometry instead.
+ODOMETRY_WAIT = 0.5
+
+
+def _anchor_on(pose: tuple[float, float, float], odom: tuple[float, float, float],
+               odom_yaw: float) -> tuple[float, float, float]:
+    """``map → odom`` (x, y, yaw) such that ``map → odom → robot`` is ``pose`` (x, y, yaw),
+    given ``odom → robot``'s position ``odom[:2]`` at the pose's instant and its yaw
+    ``odom_yaw`` at the instant of the pose's yaw."""
+    t_yaw = normalize_angle(pose[2] - odom_yaw)
+    c, s = math.cos(t_yaw), math.sin(t_yaw)
+    return pose[0] - (c * odom[0] - s * odom[1]), pose[1] - (s * odom[0] + c * odom[1]), t_yaw
+
+
+def _compose(anchor: tuple[float, float, float],
+             odom: tuple[float, float, float]) -> tuple[float, float, float]:
+    """``map → odom`` ``anchor`` applied to ``odom → robot`` ``odom``: the robot in the map."""
+    c, s = math.cos(anchor[2]), math.sin(anchor[2])
+    return (anchor[0] + c * odom[0] - s * odom[1], anchor[1] + s * odom[0] + c * odom[1],
+            normalize_angle(anchor[2] + odom[2]))
 
 
 class GpsLocalizer(LocalizerMethodBase):
@@ -102,8 +129,8 @@ class GpsLocalizer(LocalizerMethodBase):
         self._broadcaster = None
         self._reported_rejections = 0
         self._reported_releases = 0
-        #: map → odom as of the last fix anchored: (fix stamp, tx, ty, yaw).
-        self._anchor: tuple[float, float, float, float] | None = None
+        #: map → odom as last anchored: (the estimator's fixes_taken then, tx, ty, yaw).
+        self._anchor: tuple[int, float, float, float] | None = None
         self._sent_stamp = -math.inf
 
     def on_initialize(self) -> None:
@@ -135,10 +162,22 @@ class GpsLocalizer(LocalizerMethodBase):
             self.estimator.add_imu(imu)
 
     def on_last_known_pose(self, pose: Odometry) -> None:
-        """Continue from ``pose``: later fixes are shifted so it holds."""
+        """Continue from ``pose``: later fixes are shifted so it holds, and ``map → odom`` is
+        anchored on it (at its stamp). The shift compares it with where the estimate put the
+        robot at that instant (the last fix moved on by odometry), not with the last fix, so the
+        motion in between does not stay in it as a bias."""
+        stamp = pose.header.stamp
         with self._lock:
-            self.estimator.reset(pose.pose.x, pose.pose.y, pose.pose.yaw)
-            self._anchor = None  # anchored again at the next update
+            current = None
+            if self._anchor is not None:
+                odom = self._odometry_at(stamp)
+                if odom is not None:
+                    current = _compose(self._anchor[1:], odom)[:2]
+            self.estimator.reset(pose.pose.x, pose.pose.y, pose.pose.yaw, current)
+            odom = self._odometry_at(stamp)
+            self._anchor = None if odom is None else (
+                self.estimator.fixes_taken, *_anchor_on((pose.pose.x, pose.pose.y, pose.pose.yaw),
+                                                        odom, odom[2]))
 
     # -- cycle ---------------------------------------------------------------------------------
     def update_rt(self, nav_state: NavState) -> None:
@@ -153,7 +192,8 @@ class GpsLocalizer(LocalizerMethodBase):
                 self._throttle.warn(self.logger, "no-fix", f"{self.plugin_name}: no GNSS fix yet")
                 return
             self._report_gate(e)
-            fix = (float(e.position[0]), float(e.position[1]), e.fix_stamp, e.yaw, e.imu_stamp)
+            fix = (float(e.position[0]), float(e.position[1]), e.fix_stamp, e.yaw, e.imu_stamp,
+                   float(e.angular_velocity[2]), e.fixes_taken)
             qx, qy, qz, qw = _rpy_quaternion(e.roll, e.pitch, e.yaw)
             tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
             odometry = Odometry(
@@ -187,13 +227,28 @@ class GpsLocalizer(LocalizerMethodBase):
                                 f"{self.plugin_name}: the fixes stayed away from the estimate "
                                 f"for {GATE_RELEASE} in a row: the estimate moves to them")
 
+    def _odometry_at(self, stamp: float) -> tuple[float, float, float] | None:
+        """``odom → robot`` (x, y, yaw) at ``stamp`` (the latest when TF has none then; the
+        latest for 0), None without odometry."""
+        buffer = get_tf_buffer(self.context.namespace)
+        tf_info = buffer.get_tf_info()
+        try:
+            _, (ox, oy, _, *q) = buffer.lookup_transform_values_near(
+                tf_info.odom_frame, tf_info.robot_footprint_frame, stamp)
+        except LookupError:
+            return None
+        return ox, oy, quaternion_to_yaw(*q)
+
     def _send_map_to_odom(self, x: float, y: float, fix_stamp: float, yaw: float,
-                          yaw_stamp: float | None) -> None:
-        """``map → odom`` that puts the robot at the estimate: computed once per fix (its
-        position with ``odom → robot`` at its stamp; the rotation from the IMU filter's yaw
-        with ``odom → robot``'s yaw at that yaw's stamp), then re-sent stamped with the newest
+                          yaw_stamp: float | None, yaw_rate: float, taken: int) -> None:
+        """``map → odom`` that puts the robot at the estimate, anchored once per fix taken:
+        the fix's position with ``odom → robot`` at its stamp, the rotation from the IMU
+        filter's yaw with odometry's yaw at one instant (the yaw moved back by the gyro to the
+        newest odometry when the IMU is ahead of it). Re-sent stamped with the newest
         ``odom → robot``, so that between fixes and through an outage the TF tree's robot
-        moves with odometry from the last fix.
+        moves on with odometry from the last fix. A fix ahead of the newest odometry waits for
+        it, up to :data:`ODOMETRY_WAIT` (more: another clock, or odometry stalled; anchored on
+        the latest odometry, with a warning).
 
         The original broadcast a static identity, which put the TF tree's robot at the wheel
         odometry's pose: after a few minutes of wheel slip that was metres from
@@ -202,29 +257,38 @@ class GpsLocalizer(LocalizerMethodBase):
         path)."""
         buffer = get_tf_buffer(self.context.namespace)
         tf_info = buffer.get_tf_info()
-        odom, robot = tf_info.odom_frame, tf_info.robot_footprint_frame
         try:
-            newest, _ = buffer.lookup_transform_values(odom, robot)
-            if self._anchor is None or (self._anchor[0] != fix_stamp and newest >= fix_stamp):
-                _, (ox, oy, _, *q) = buffer.lookup_transform_values_near(odom, robot, fix_stamp)
-                turn = quaternion_to_yaw(*q)
-                if yaw_stamp is not None:
-                    turn = quaternion_to_yaw(*buffer.lookup_transform_values_near(
-                        odom, robot, yaw_stamp)[1][3:])
-                t_yaw = normalize_angle(yaw - turn)
-                c, s = math.cos(t_yaw), math.sin(t_yaw)
-                self._anchor = (fix_stamp, x - (c * ox - s * oy), y - (s * ox + c * oy), t_yaw)
+            newest, _ = buffer.lookup_transform_values(tf_info.odom_frame,
+                                                       tf_info.robot_footprint_frame)
         except LookupError as exc:  # no odometry transform (yet): nothing to anchor it on
             self._throttle.warn(self.logger, "no-odom-tf",
                                 f"{self.plugin_name}: no map → odom: {exc}")
             return
+        if newest < self._sent_stamp - CLOCK_JUMP:  # the clock went back: start again
+            self._sent_stamp, self._anchor = -math.inf, None
+        ahead = fix_stamp - newest
+        if (self._anchor is None or self._anchor[0] != taken) and (
+                ahead <= 0.0 or ahead > ODOMETRY_WAIT or fix_stamp <= 0.0):
+            if ahead > ODOMETRY_WAIT:
+                self._throttle.warn(self.logger, "fix-ahead",
+                                    f"{self.plugin_name}: the fix is {ahead:.2f} s ahead of the "
+                                    f"newest odometry: map → odom anchored on the latest")
+            at = min(fix_stamp, newest) if fix_stamp > 0.0 else newest
+            odom = self._odometry_at(at)
+            yaw_at = newest if yaw_stamp is None else min(yaw_stamp, newest)
+            yaw_then = yaw if yaw_stamp is None else yaw - yaw_rate * (yaw_stamp - yaw_at)
+            odom_yaw = self._odometry_at(yaw_at)
+            if odom is None or odom_yaw is None:
+                return
+            self._anchor = (taken, *_anchor_on((x, y, yaw_then), odom, odom_yaw[2]))
         stamp = max(fix_stamp, newest)
         if self._anchor is None or stamp <= self._sent_stamp:
             return  # nothing newer to say (a repeated stamp is TF_REPEATED_DATA for tf2)
         self._sent_stamp = stamp
         _, tx, ty, t_yaw = self._anchor
-        transform = TransformStamped(Header(stamp, tf_info.map_frame), odom, Transform(
-            np.array((tx, ty, 0.0)), np.array(yaw_to_quaternion(t_yaw))))
+        transform = TransformStamped(Header(stamp, tf_info.map_frame), tf_info.odom_frame,
+                                     Transform(np.array((tx, ty, 0.0)),
+                                               np.array(yaw_to_quaternion(t_yaw))))
         if self._broadcaster is not None:
             self._broadcaster.send_transform(transform)
         else:

@@ -20,6 +20,9 @@ UNKNOWN_VARIANCE = 1.0
 GATE_RELEASE = 5
 #: Standard deviations of a fix's own noise allowed beyond the way the robot can have driven.
 GATE_SIGMAS = 5.0
+#: A fix stamped this much (s) before the last fix taken means the clock went back (a
+#: simulator or a bag restarted): the estimator starts its time line again. Less: out of order.
+CLOCK_JUMP = 1.0
 
 
 def _wrap(a: float) -> float:
@@ -43,7 +46,9 @@ class GpsPoseEstimator:
       multipath jump: one fix 30 m off moved ``robot_pose`` 30 m for a fix period), unless
       :data:`GATE_RELEASE` fixes in a row were (``released_jumps`` counts the far fixes taken
       so). ``rejected_fixes`` counts the rejected ones. An unstamped fix (0) is not gated (the
-      time since the last one is unknown); one older than the last fix taken is dropped.
+      time since the last one is unknown); one older than the last fix taken is dropped, unless
+      by more than :data:`CLOCK_JUMP` (the clock went back: its time line starts again).
+      ``fixes_taken`` counts the fixes taken and the resets (a change means a new anchor).
 
     Raises ImportError naming the extra without pyproj. Thread contract: none (the plugin
     serialises calls).
@@ -54,6 +59,7 @@ class GpsPoseEstimator:
         self.gate_speed = float(gate_speed)
         self.rejected_fixes = 0
         self.released_jumps = 0
+        self.fixes_taken = 0
         self._rejected_in_a_row = 0
         self.fix_stamp = 0.0
         self.offset = np.array((x0, y0))
@@ -71,8 +77,16 @@ class GpsPoseEstimator:
 
     def add_fix(self, fix: GNSSPerception) -> bool:
         """Take a fix; False when it has none (ignored) or the jump gate rejects it."""
-        if not fix.has_fix or 0.0 < fix.stamp < self.fix_stamp:
+        if not fix.has_fix:
             return False
+        if 0.0 < fix.stamp < self.fix_stamp:
+            if fix.stamp > self.fix_stamp - CLOCK_JUMP:
+                return False  # out of order
+            # The clock went back (a restart): a new time line, the first fix on it ungated.
+            self.fix_stamp = self.stamp = 0.0
+            self._rejected_in_a_row = 0
+            self._imu_stamp = None
+            self.position = None
         if self.projection is None:
             self.projection = UtmProjection(fix.latitude, fix.longitude, fix.altitude)
         east, north = self.projection.forward(fix.latitude, fix.longitude)
@@ -91,6 +105,7 @@ class GpsPoseEstimator:
                 return False
             self.released_jumps += 1  # the offset lasted: taken
         self._rejected_in_a_row = 0
+        self.fixes_taken += 1
         self.position, self.position_covariance = position, covariance
         self.fix_stamp = max(self.fix_stamp, fix.stamp)
         self.stamp = max(self.stamp, fix.stamp)
@@ -112,6 +127,8 @@ class GpsPoseEstimator:
         if imu.has_orientation:
             self.roll, self.pitch, imu_yaw = quaternion_to_rpy(*imu.orientation)
             var_imu = float(imu.orientation_covariance[2, 2]) or UNKNOWN_VARIANCE
+        if imu.has_angular_velocity:
+            self.angular_velocity = np.asarray(imu.angular_velocity, dtype=float).copy()
         if not self._yaw_initialised:
             if imu_yaw is not None:
                 self.yaw, self.yaw_variance = imu_yaw, var_imu
@@ -122,7 +139,6 @@ class GpsPoseEstimator:
         self._imu_stamp = imu.stamp
         wz = float(imu.angular_velocity[2]) if imu.has_angular_velocity else 0.0
         var_w = float(imu.angular_velocity_covariance[2, 2]) if imu.has_angular_velocity else 0.0
-        self.angular_velocity = np.asarray(imu.angular_velocity, dtype=float).copy()
         predicted = self.yaw + wz * dt
         variance = self.yaw_variance + var_w * dt * dt
         if imu_yaw is None:
@@ -138,11 +154,17 @@ class GpsPoseEstimator:
         """Stamp of the last IMU reading (the time :attr:`yaw` is of), None before one."""
         return self._imu_stamp
 
-    def reset(self, x: float, y: float, yaw: float) -> None:
-        """Move the estimate to ``(x, y, yaw)``: later fixes are shifted to agree."""
+    def reset(self, x: float, y: float, yaw: float,
+              current: tuple[float, float] | None = None) -> None:
+        """Move the estimate to ``(x, y, yaw)``: later fixes are shifted to agree.
+        ``current``: where the estimate puts the robot at the instant of ``(x, y)`` (the last
+        fix moved on by odometry), when known; else the last fix's position (the motion since
+        it would stay in the shift as a bias)."""
         self._rejected_in_a_row = 0
+        self.fixes_taken += 1
         if self.position is not None:
-            self.offset += np.array((x, y)) - self.position
+            base = self.position if current is None else np.asarray(current, dtype=float)
+            self.offset += np.array((x, y)) - base
             self.position = np.array((x, y))
         else:
             self.offset = np.array((x, y))
