@@ -67,16 +67,15 @@ def test_a_long_protective_stop_is_an_error_the_goal_stays_and_the_robot_goes_on
         reports = [r.message for r in run.monitor.reports if r.stamp >= stop_at]
 
     # WARN while stopped, ERROR once the stop lasted max_stop_time; the goal stayed active.
-    # How long EasyNav saw the stop is measured on its clock alone, from the WARN that began
-    # it: this process's clock and EasyNav's differ by up to tenths of a second on a loaded
-    # machine (measured from the stop sent, the margin was 0.1 s). A diagnostics array is
-    # stamped when its recovery cycle starts and the evaluator reads the clock during the
-    # cycle, a few milliseconds later: 0.05 s of slack for that. The ERROR comes within 3 s of
-    # the stop sent.
+    # How long the stop lasted is the ERROR's own stop_duration, on EasyNav's clock. Not the
+    # ERROR's stamp minus the stop sent: this process's clock and EasyNav's differ by up to
+    # tenths of a second on a loaded machine (that margin was 0.1 s), nor minus the first WARN's
+    # stamp: a diagnostics array is stamped when its recovery cycle starts, and the evaluator
+    # reads the clock later in the cycle (3.98 s between the stamps for a 4.0 s stop, measured).
+    # The ERROR comes within 3 s of the stop sent.
     assert warn is not None and warn.stamp < error.stamp
     assert float(error.values["stop_duration"]) >= MAX_STOP_TIME, error.values
     began = _stop_seen_at(run.monitor.diagnostics, error)
-    assert error.stamp - began >= MAX_STOP_TIME - 0.05, (began, error.stamp)
     stopped_for = error.stamp - stop_at
     assert stopped_for < MAX_STOP_TIME + 3.0, stopped_for
     assert "for too long" in error.message, error.message
@@ -120,8 +119,9 @@ def test_a_long_protective_stop_is_an_error_the_goal_stays_and_the_robot_goes_on
     print(
         f"\nprotective stop at t={stop_sim:.2f} s, zero command at the robot "
         f"{reaction * 1000:.1f} ms (wall) later, braked within "
-        f"{max(moved):.3f} m; ERROR after {stopped_for:.1f} s ({error.stamp - began:.2f} s on "
-        f"EasyNav's clock; max_stop_time {MAX_STOP_TIME} s); "
+        f"{max(moved):.3f} m; ERROR after {stopped_for:.1f} s (stop_duration "
+        f"{error.values['stop_duration']} s, {error.stamp - began:.2f} s after the first WARN; "
+        f"max_stop_time {MAX_STOP_TIME} s); "
         f"released at t={released_at:.1f} s; goal reached {ended_at - released_at:.1f} s later"
     )
 
