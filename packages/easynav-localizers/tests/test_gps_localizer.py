@@ -263,3 +263,26 @@ def test_a_handover_between_fixes_leaves_no_bias():
     assert nav_state.get("robot_pose", Odometry).pose.x == pytest.approx(2.0, abs=1e-3)
     _, (tx, *_r) = buffer.lookup_transform_values("map", "base_footprint")  # t = 2.4
     assert tx == pytest.approx(2.4, abs=1e-3)
+
+
+def test_map_to_odom_is_never_stamped_ahead_of_odometry():
+    """Fixes on another clock (1000 s ahead of odometry) and a non-finite gyro reading: map ->
+    odom is anchored on the latest odometry and stamped with it, so map -> robot resolves.
+    Stamped with the fix, it stood ahead of the rest of the tree and every lookup through map
+    failed; a NaN gyro made the yaw NaN for good."""
+    from easynav.common.tf import get_tf_buffer
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace="gps_test_clocks")
+    buffer = get_tf_buffer("gps_test_clocks")
+    _odometry_line(buffer, [0.1 * k for k in range(0, 11)])
+    plugin.add_imu(ImuPerception(orientation=np.array(yaw_to_quaternion(0.0)),
+                                 orientation_covariance=np.eye(3) * 0.01,
+                                 angular_velocity=np.array((0.0, 0.0, math.nan)),
+                                 angular_velocity_covariance=np.eye(3) * 0.01, stamp=1.0))
+    plugin.add_fix(_fix(projection, 0.0, 0.0, 1000.0))
+    plugin.update(NavState())
+    stamp, (tx, ty, *_r) = buffer.lookup_transform_values("map", "base_footprint")
+    assert stamp == pytest.approx(1.0)
+    assert (tx, ty) == pytest.approx((0.0, 0.0), abs=1e-9)
+    assert math.isfinite(plugin.estimator.yaw)

@@ -155,7 +155,8 @@ class GpsLocalizer(LocalizerMethodBase):
 
     def add_imu(self, imu: ImuPerception) -> None:
         """An IMU reading. Any thread."""
-        if not np.all(np.isfinite(imu.orientation)):
+        if not (np.all(np.isfinite(imu.orientation))
+                and np.all(np.isfinite(imu.angular_velocity))):
             self._throttle.warn(self.logger, "imu-nan", f"{self.plugin_name}: non-finite IMU")
             return
         with self._lock:
@@ -168,12 +169,18 @@ class GpsLocalizer(LocalizerMethodBase):
         motion in between does not stay in it as a bias."""
         stamp = pose.header.stamp
         with self._lock:
+            e = self.estimator
             current = None
-            if self._anchor is not None:
-                odom = self._odometry_at(stamp)
-                if odom is not None:
-                    current = _compose(self._anchor[1:], odom)[:2]
-            self.estimator.reset(pose.pose.x, pose.pose.y, pose.pose.yaw, current)
+            if e.position is not None:  # the last fix moved on by odometry to the pose's stamp
+                then, now = self._odometry_at(e.last_fix_stamp), self._odometry_at(stamp)
+                if then is not None and now is not None:
+                    turn = (self._anchor[3] if self._anchor is not None
+                            else normalize_angle(e.yaw - now[2]))
+                    c, s = math.cos(turn), math.sin(turn)
+                    dx, dy = now[0] - then[0], now[1] - then[1]
+                    current = (float(e.position[0]) + c * dx - s * dy,
+                               float(e.position[1]) + s * dx + c * dy)
+            e.reset(pose.pose.x, pose.pose.y, pose.pose.yaw, current, stamp)
             odom = self._odometry_at(stamp)
             self._anchor = None if odom is None else (
                 self.estimator.fixes_taken, *_anchor_on((pose.pose.x, pose.pose.y, pose.pose.yaw),
@@ -192,8 +199,8 @@ class GpsLocalizer(LocalizerMethodBase):
                 self._throttle.warn(self.logger, "no-fix", f"{self.plugin_name}: no GNSS fix yet")
                 return
             self._report_gate(e)
-            fix = (float(e.position[0]), float(e.position[1]), e.fix_stamp, e.yaw, e.imu_stamp,
-                   float(e.angular_velocity[2]), e.fixes_taken)
+            fix = (float(e.position[0]), float(e.position[1]), e.last_fix_stamp, e.yaw,
+                   e.imu_stamp, float(e.angular_velocity[2]), e.fixes_taken)
             qx, qy, qz, qw = _rpy_quaternion(e.roll, e.pitch, e.yaw)
             tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
             odometry = Odometry(
@@ -275,13 +282,23 @@ class GpsLocalizer(LocalizerMethodBase):
                                     f"newest odometry: map → odom anchored on the latest")
             at = min(fix_stamp, newest) if fix_stamp > 0.0 else newest
             odom = self._odometry_at(at)
-            yaw_at = newest if yaw_stamp is None else min(yaw_stamp, newest)
-            yaw_then = yaw if yaw_stamp is None else yaw - yaw_rate * (yaw_stamp - yaw_at)
+            # The IMU's yaw paired with odometry's at one instant: moved back by the gyro when
+            # the IMU is a little ahead of odometry; much further ahead (odometry stalled,
+            # another clock) the gyro's bias would add up: paired as it is.
+            lead = 0.0 if yaw_stamp is None else yaw_stamp - newest
+            yaw_at = newest if yaw_stamp is None or lead > 0.0 else yaw_stamp
+            yaw_then = yaw - yaw_rate * lead if 0.0 < lead <= ODOMETRY_WAIT else yaw
             odom_yaw = self._odometry_at(yaw_at)
             if odom is None or odom_yaw is None:
                 return
-            self._anchor = (taken, *_anchor_on((x, y, yaw_then), odom, odom_yaw[2]))
-        stamp = max(fix_stamp, newest)
+            anchor = _anchor_on((x, y, yaw_then), odom, odom_yaw[2])
+            if not all(math.isfinite(v) for v in anchor):
+                return
+            self._anchor = (taken, *anchor)
+        # Stamped with the newest odometry, never ahead of it: a transform ahead of the rest
+        # of the tree (a fix on another clock, odometry stalled, a fix left from before a
+        # restart) made every lookup through map fail.
+        stamp = newest
         if self._anchor is None or stamp <= self._sent_stamp:
             return  # nothing newer to say (a repeated stamp is TF_REPEATED_DATA for tf2)
         self._sent_stamp = stamp

@@ -62,6 +62,8 @@ class GpsPoseEstimator:
         self.fixes_taken = 0
         self._rejected_in_a_row = 0
         self.fix_stamp = 0.0
+        #: Stamp of the last fix taken (0: unstamped), what its position is of.
+        self.last_fix_stamp = 0.0
         self.offset = np.array((x0, y0))
         self.projection: UtmProjection | None = None
         self.position: np.ndarray | None = None
@@ -83,7 +85,7 @@ class GpsPoseEstimator:
             if fix.stamp > self.fix_stamp - CLOCK_JUMP:
                 return False  # out of order
             # The clock went back (a restart): a new time line, the first fix on it ungated.
-            self.fix_stamp = self.stamp = 0.0
+            self.fix_stamp = self.stamp = self.last_fix_stamp = 0.0
             self._rejected_in_a_row = 0
             self._imu_stamp = None
             self.position = None
@@ -107,6 +109,7 @@ class GpsPoseEstimator:
         self._rejected_in_a_row = 0
         self.fixes_taken += 1
         self.position, self.position_covariance = position, covariance
+        self.last_fix_stamp = fix.stamp
         self.fix_stamp = max(self.fix_stamp, fix.stamp)
         self.stamp = max(self.stamp, fix.stamp)
         return True
@@ -155,11 +158,14 @@ class GpsPoseEstimator:
         return self._imu_stamp
 
     def reset(self, x: float, y: float, yaw: float,
-              current: tuple[float, float] | None = None) -> None:
-        """Move the estimate to ``(x, y, yaw)``: later fixes are shifted to agree.
-        ``current``: where the estimate puts the robot at the instant of ``(x, y)`` (the last
-        fix moved on by odometry), when known; else the last fix's position (the motion since
-        it would stay in the shift as a bias)."""
+              current: tuple[float, float] | None = None, stamp: float = 0.0) -> None:
+        """Move the estimate to ``(x, y, yaw)`` (the robot's pose at ``stamp``): later fixes
+        are shifted to agree. ``current``: where the estimate puts the robot at that instant
+        (the last fix moved on by odometry), when known; else the last fix's position (the
+        motion since it would stay in the shift as a bias)."""
+        self.stamp = max(self.stamp, stamp)
+        if stamp > 0.0:
+            self.last_fix_stamp = stamp
         self._rejected_in_a_row = 0
         self.fixes_taken += 1
         if self.position is not None:
