@@ -276,13 +276,70 @@ def test_map_to_odom_is_never_stamped_ahead_of_odometry():
     plugin = _plugin(namespace="gps_test_clocks")
     buffer = get_tf_buffer("gps_test_clocks")
     _odometry_line(buffer, [0.1 * k for k in range(0, 11)])
-    plugin.add_imu(ImuPerception(orientation=np.array(yaw_to_quaternion(0.0)),
-                                 orientation_covariance=np.eye(3) * 0.01,
-                                 angular_velocity=np.array((0.0, 0.0, math.nan)),
-                                 angular_velocity_covariance=np.eye(3) * 0.01, stamp=1.0))
+    for k, rate in enumerate((0.0, math.nan, 0.0)):  # the NaN between two good readings
+        plugin.add_imu(ImuPerception(orientation=np.array(yaw_to_quaternion(0.0)),
+                                     orientation_covariance=np.eye(3) * 0.01,
+                                     angular_velocity=np.array((0.0, 0.0, rate)),
+                                     angular_velocity_covariance=np.eye(3) * 0.01,
+                                     stamp=0.8 + 0.1 * k))
     plugin.add_fix(_fix(projection, 0.0, 0.0, 1000.0))
     plugin.update(NavState())
     stamp, (tx, ty, *_r) = buffer.lookup_transform_values("map", "base_footprint")
     assert stamp == pytest.approx(1.0)
     assert (tx, ty) == pytest.approx((0.0, 0.0), abs=1e-9)
     assert math.isfinite(plugin.estimator.yaw)
+
+
+@pytest.mark.parametrize("case", ["outage", "unstamped", "two handovers"])
+def test_a_handover_measures_the_estimate_where_odometry_can(case):
+    """Odometry streams in (x = t, the map origin where the first fix was, at odometry's
+    x = 1); handovers put the robot where it truly is. Each one's shift compares it with the
+    estimate at its stamp, from the anchor of the current fix: odometry from the fix's own
+    stamp was gone after an outage longer than TF's history (the next fix landed 28 m off),
+    and unknown for an unstamped fix (0.8 m off). The last fix, where the robot is, gives
+    robot_pose."""
+    from easynav.common.tf import get_tf_buffer
+    from easynav.core.types import Header, Pose
+
+    namespace = f"gps_test_handover_{case.replace(' ', '_')}"
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace=namespace)
+    buffer = get_tf_buffer(namespace)
+    streamed = [0.0]
+
+    def stream(until: float) -> None:  # odometry every 0.1 s up to ``until``
+        k = round(streamed[0] / 0.1)
+        while k * 0.1 <= until + 1e-9:
+            _odometry_line(buffer, [k * 0.1])
+            k += 1
+        streamed[0] = k * 0.1
+
+    def handover(stamp: float, x: float) -> None:
+        plugin.on_last_known_pose(Odometry(header=Header(stamp, "map"),
+                                           pose=Pose.from_xy_yaw(x, 0.0, 0.0)))
+
+    stream(1.0)
+    plugin.add_fix(_fix(projection, 0.0, 0.0, 0.0 if case == "unstamped" else 1.0))
+    plugin.update(NavState())
+    if case == "outage":
+        stream(29.0)
+        handover(29.0, 28.0)
+        stream(30.0)
+        plugin.add_fix(_fix(projection, 29.0, 0.0, 30.0))
+        expected = 29.0
+    elif case == "unstamped":
+        stream(1.8)
+        handover(1.8, 0.8)
+        stream(2.4)
+        plugin.add_fix(_fix(projection, 1.4, 0.0, 0.0))
+        expected = 1.4
+    else:
+        handover(0.0, 0.0)  # unstamped: now
+        stream(2.0)
+        handover(2.0, 1.0)
+        stream(3.0)
+        plugin.add_fix(_fix(projection, 2.0, 0.0, 3.0))
+        expected = 2.0
+    nav_state = NavState()
+    plugin.update(nav_state)
+    assert nav_state.get("robot_pose", Odometry).pose.x == pytest.approx(expected, abs=1e-3)

@@ -155,8 +155,8 @@ class GpsLocalizer(LocalizerMethodBase):
 
     def add_imu(self, imu: ImuPerception) -> None:
         """An IMU reading. Any thread."""
-        if not (np.all(np.isfinite(imu.orientation))
-                and np.all(np.isfinite(imu.angular_velocity))):
+        if not (np.all(np.isfinite(imu.orientation)) and (
+                not imu.has_angular_velocity or np.all(np.isfinite(imu.angular_velocity)))):
             self._throttle.warn(self.logger, "imu-nan", f"{self.plugin_name}: non-finite IMU")
             return
         with self._lock:
@@ -170,21 +170,36 @@ class GpsLocalizer(LocalizerMethodBase):
         stamp = pose.header.stamp
         with self._lock:
             e = self.estimator
-            current = None
-            if e.position is not None:  # the last fix moved on by odometry to the pose's stamp
-                then, now = self._odometry_at(e.last_fix_stamp), self._odometry_at(stamp)
-                if then is not None and now is not None:
-                    turn = (self._anchor[3] if self._anchor is not None
-                            else normalize_angle(e.yaw - now[2]))
-                    c, s = math.cos(turn), math.sin(turn)
-                    dx, dy = now[0] - then[0], now[1] - then[1]
-                    current = (float(e.position[0]) + c * dx - s * dy,
-                               float(e.position[1]) + s * dx + c * dy)
-            e.reset(pose.pose.x, pose.pose.y, pose.pose.yaw, current, stamp)
+            e.reset(pose.pose.x, pose.pose.y, pose.pose.yaw, self._estimate_at(stamp), stamp)
             odom = self._odometry_at(stamp)
             self._anchor = None if odom is None else (
                 self.estimator.fixes_taken, *_anchor_on((pose.pose.x, pose.pose.y, pose.pose.yaw),
                                                         odom, odom[2]))
+
+    def _estimate_at(self, stamp: float) -> tuple[float, float] | None:
+        """Where the estimate puts the robot at ``stamp``: the current anchor with odometry
+        then, or (a fix taken since the last anchor) that fix moved on by the odometry from its
+        stamp; None when odometry does not cover it (an unstamped fix, an outage longer than
+        TF's history). Under the lock."""
+        e = self.estimator
+        now = self._odometry_at(stamp)
+        if e.position is None or now is None:
+            return None
+        if self._anchor is not None and self._anchor[0] == e.fixes_taken:
+            return _compose(self._anchor[1:], now)[:2]
+        if e.last_fix_stamp <= 0.0:
+            return None
+        buffer = get_tf_buffer(self.context.namespace)
+        tf_info = buffer.get_tf_info()
+        try:  # exactly at the fix's stamp: no fallback to the latest
+            _, (ox, oy, *_rest) = buffer.lookup_transform_values(
+                tf_info.odom_frame, tf_info.robot_footprint_frame, e.last_fix_stamp)
+        except LookupError:
+            return None
+        turn = self._anchor[3] if self._anchor is not None else normalize_angle(e.yaw - now[2])
+        c, s = math.cos(turn), math.sin(turn)
+        dx, dy = now[0] - ox, now[1] - oy
+        return float(e.position[0]) + c * dx - s * dy, float(e.position[1]) + s * dx + c * dy
 
     # -- cycle ---------------------------------------------------------------------------------
     def update_rt(self, nav_state: NavState) -> None:

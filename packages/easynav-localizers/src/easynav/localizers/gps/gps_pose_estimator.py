@@ -164,8 +164,7 @@ class GpsPoseEstimator:
         (the last fix moved on by odometry), when known; else the last fix's position (the
         motion since it would stay in the shift as a bias)."""
         self.stamp = max(self.stamp, stamp)
-        if stamp > 0.0:
-            self.last_fix_stamp = stamp
+        self.last_fix_stamp = stamp  # what the position is now of (0: unknown)
         self._rejected_in_a_row = 0
         self.fixes_taken += 1
         if self.position is not None:
