@@ -155,7 +155,7 @@ class GpsLocalizer(LocalizerMethodBase):
 
     def add_imu(self, imu: ImuPerception) -> None:
         """An IMU reading. Any thread."""
-        if not (np.all(np.isfinite(imu.orientation)) and (
+        if not ((not imu.has_orientation or np.all(np.isfinite(imu.orientation))) and (
                 not imu.has_angular_velocity or np.all(np.isfinite(imu.angular_velocity)))):
             self._throttle.warn(self.logger, "imu-nan", f"{self.plugin_name}: non-finite IMU")
             return
