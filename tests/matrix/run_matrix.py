@@ -17,6 +17,10 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --only S   only the combinations whose name contains one of the comma-separated S
   --list     print the combinations and exit
   --report   write docs/matrix.md from the results file without running anything
+  --merge F  append to the results file the runs that results files F... (copies of it that
+             went on elsewhere: another clone, another machine) hold and it does not, then
+             write docs/matrix.md as --report does. Merge a clone's file before resetting
+             that clone, or its runs are lost
 
 A failed row's verdict says what a user would notice first (collisions, waypoints missed, the
 run's message) and, when the failure was looked into, why: tests/matrix/findings.yaml lists the
@@ -74,6 +78,28 @@ def load_results(path: Path) -> dict[str, dict]:
         except (ValueError, KeyError, TypeError):
             continue
     return found
+
+
+def merge_results(path: Path, others: list[Path]) -> int:
+    """Append to ``path`` every run line of ``others`` that it does not hold (the same line),
+    in their order: copies of ``path`` that went on elsewhere add their newer runs, which win
+    as the later lines of their names. Returns the number of lines appended. Lines that are
+    not a run (cut short, not JSON) are skipped."""
+    have = set(path.read_text().splitlines()) if path.exists() else set()
+    new: list[str] = []
+    for other in others:
+        for line in other.read_text().splitlines():
+            try:
+                json.loads(line)["name"]
+            except (ValueError, KeyError, TypeError):
+                continue
+            if line not in have:
+                have.add(line)
+                new.append(line)
+    if new:
+        with path.open("a") as out:
+            out.writelines(line + "\n" for line in new)
+    return len(new)
 
 
 def params_fingerprint(combo) -> str:
@@ -160,6 +186,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--only", default="")
     parser.add_argument("--output", default=str(ROOT / "docs" / "matrix.md"))
     parser.add_argument("--list", action="store_true")
+    parser.add_argument("--merge", nargs="+", default=[], metavar="FILE")
     parser.add_argument("--run-one", help=argparse.SUPPRESS)
     parser.add_argument("--run-dir", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -188,6 +215,10 @@ def main(argv: list[str]) -> int:
     results_path.parent.mkdir(parents=True, exist_ok=True)
     if args.fresh:
         results_path.unlink(missing_ok=True)
+    if args.merge:
+        appended = merge_results(results_path, [Path(p) for p in args.merge])
+        print(f"merged {appended} runs into {results_path}", flush=True)
+        args.report = True
     kept = load_results(results_path)
     fingerprints = {} if args.report else {c.name: params_fingerprint(c) for c in combos}
     stale = stale_rows(combos, kept, fingerprints)

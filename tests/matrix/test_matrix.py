@@ -181,6 +181,27 @@ def test_a_row_kept_with_other_params_runs_again():
     assert stale_rows(home, kept, {}) == set()  # --report: nothing is run
 
 
+def test_merging_a_clones_results_appends_its_newer_runs(tmp_path):
+    """A clone that ran on from a copy of the results file: its extra runs are appended (and
+    win as the later lines of their names); what both hold, and lines cut short, are not."""
+    import json
+
+    from run_matrix import load_results, merge_results
+
+    def line(name, code):
+        return json.dumps({"name": name, "exit_code": code})
+
+    main = tmp_path / "main.jsonl"
+    main.write_text("\n".join([line("a", 0), line("b", 1)]) + "\n")
+    clone = tmp_path / "clone.jsonl"
+    clone.write_text("\n".join([line("a", 0), line("b", 1), line("b", 0), line("c", 0),
+                                 '{"name": "d", "exit_co']) + "\n")
+    assert merge_results(main, [clone]) == 2
+    assert merge_results(main, [clone]) == 0  # nothing new the second time
+    kept = load_results(main)
+    assert {name: row["exit_code"] for name, row in kept.items()} == {"a": 0, "b": 0, "c": 0}
+
+
 def test_two_maps_managers_side_by_side_only_where_a_plugin_needs_both():
     from matrix import plugin_class
 
