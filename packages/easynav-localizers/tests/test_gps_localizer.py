@@ -318,28 +318,21 @@ def test_a_handover_measures_the_estimate_where_odometry_can(case):
         plugin.on_last_known_pose(Odometry(header=Header(stamp, "map"),
                                            pose=Pose.from_xy_yaw(x, 0.0, 0.0)))
 
+    # (odometry streamed up to, then a handover (stamp, x) or None), the last fix (x, stamp).
+    steps, (last_x, last_stamp) = {
+        "outage": ([(29.0, (29.0, 28.0)), (30.0, None)], (29.0, 30.0)),
+        "unstamped": ([(1.8, (1.8, 0.8)), (2.4, None)], (1.4, 0.0)),
+        "two handovers": ([(1.0, (0.0, 0.0)), (2.0, (2.0, 1.0)), (3.0, None)], (2.0, 3.0)),
+    }[case]
     stream(1.0)
     plugin.add_fix(_fix(projection, 0.0, 0.0, 0.0 if case == "unstamped" else 1.0))
     plugin.update(NavState())
-    if case == "outage":
-        stream(29.0)
-        handover(29.0, 28.0)
-        stream(30.0)
-        plugin.add_fix(_fix(projection, 29.0, 0.0, 30.0))
-        expected = 29.0
-    elif case == "unstamped":
-        stream(1.8)
-        handover(1.8, 0.8)
-        stream(2.4)
-        plugin.add_fix(_fix(projection, 1.4, 0.0, 0.0))
-        expected = 1.4
-    else:
-        handover(0.0, 0.0)  # unstamped: now
-        stream(2.0)
-        handover(2.0, 1.0)
-        stream(3.0)
-        plugin.add_fix(_fix(projection, 2.0, 0.0, 3.0))
-        expected = 2.0
+    for until, pose in steps:
+        stream(until)
+        if pose is not None:
+            handover(*pose)
+    plugin.add_fix(_fix(projection, last_x, 0.0, last_stamp))
+    expected = last_x
     nav_state = NavState()
     plugin.update(nav_state)
     assert nav_state.get("robot_pose", Odometry).pose.x == pytest.approx(expected, abs=1e-3)
