@@ -249,3 +249,36 @@ def test_the_gps_localizers_estimate_is_read_from_its_topic(tmp_path):
     assert pose_estimate_topic(params) == "/robot/odom_gps"
     assert pose_estimate_topic(DEFAULT_PARAMS) is None
     assert pose_estimate_topic(tmp_path / "missing.yaml") is None
+
+
+def test_a_waypoint_is_stamped_when_the_goal_manager_said_it_was_reached():
+    """The feedback that lists one goal fewer is stamped by the goal manager (EasyNav's
+    simulated clock): that is when the waypoint was reached, not the newest true time this
+    process has seen when it read the feedback (under load its queue ran 16 s behind, and a
+    waypoint of the upper floor was scored where the robot then was, 4 m away on the ramp)."""
+    from types import SimpleNamespace
+
+    from easynav.core.types import Goals, Header, PoseStamped
+    from easynav.playground.demo.demo_run import DemoRun
+    from easynav.playground.demo.waypoint_result import WaypointResult
+    from easynav.system.goals.goal_client_state import GoalClientState
+    from easynav.system.goals.navigation_control import NavigationControl
+
+    run = SimpleNamespace(
+        monitor=SimpleNamespace(truth=(59.0, 1.2, 5.5, 3.1), remaining_goals=None),
+        results=[WaypointResult(1, 6.5, 4.4, 0.0), WaypointResult(2, 4.0, 1.2, 0.0),
+                 WaypointResult(3, 6.0, 4.4, 1.57)],
+        client=SimpleNamespace(get_result=lambda: None),
+    )
+    feedback = NavigationControl(header=Header(42.5, "map"),
+                                 goals=Goals(goals=[PoseStamped(), PoseStamped()]))
+    DemoRun._mark_reached(run, GoalClientState.ACCEPTED_AND_NAVIGATING, feedback)
+    assert [w.reached_at for w in run.results] == [42.5, None, None]
+    # A stamp from the future (another clock) is taken as the newest true time.
+    feedback = NavigationControl(header=Header(1e9, "map"), goals=Goals(goals=[PoseStamped()]))
+    DemoRun._mark_reached(run, GoalClientState.ACCEPTED_AND_NAVIGATING, feedback)
+    assert [w.reached_at for w in run.results] == [42.5, 59.0, None]
+    run.client = SimpleNamespace(get_result=lambda: NavigationControl(header=Header(70.0, "map")))
+    run.monitor = SimpleNamespace(truth=(75.0, 6.0, 4.4, 1.57), remaining_goals=None)
+    DemoRun._mark_reached(run, GoalClientState.NAVIGATION_FINISHED, None)
+    assert [w.reached_at for w in run.results] == [42.5, 59.0, 70.0]

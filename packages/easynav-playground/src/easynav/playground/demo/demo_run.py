@@ -225,21 +225,32 @@ class DemoRun:
         self.nav_end = monitor.truth[0]
 
     def _mark_reached(self, state, feedback) -> None:
-        """Stamp the waypoints the goal manager no longer lists as reached (the true time)."""
+        """Stamp the waypoints the goal manager no longer lists as reached: when the goal
+        manager said so (its feedback's stamp, EasyNav's simulated clock), else the newest
+        true time this process has seen.
+
+        Not when this process got round to reading it: under load its feedback queue ran 16 s
+        behind the live truth, and a waypoint of the upper floor was scored where the robot
+        then was, on the ramp 4 m away (the two-floors run failed on it).
+        """
         from easynav.system.goals.goal_client_state import GoalClientState
 
-        remaining = self.monitor.remaining_goals
-        if feedback is not None and feedback.goals.goals:
-            remaining = min(
-                remaining if remaining is not None else 10**9, len(feedback.goals.goals)
-            )
+        now = self.monitor.truth[0]
+
+        def stamp_of(message) -> float:  # a NavigationControl's stamp (s), clamped to now
+            stamp = float(message.header.stamp) if message is not None else 0.0
+            return stamp if 0.0 < stamp < now else now
+
         if state is GoalClientState.NAVIGATION_FINISHED:
-            remaining = 0
+            remaining, said_at = 0, stamp_of(self.client.get_result())
+        elif feedback is not None and feedback.goals.goals:
+            remaining, said_at = len(feedback.goals.goals), stamp_of(feedback)
+        else:  # no feedback yet: the goal manager's info topic (unstamped)
+            remaining, said_at = self.monitor.remaining_goals, now
         if remaining is not None:
-            now = self.monitor.truth[0]
             for w in self.results[: len(self.results) - remaining]:
                 if w.reached_at is None:
-                    w.reached_at = now
+                    w.reached_at = said_at
 
     def _show_progress(self, state, feedback) -> None:
         monitor, results = self.monitor, self.results
