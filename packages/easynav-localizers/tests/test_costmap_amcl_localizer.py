@@ -51,11 +51,14 @@ def ray_cast(costmap: Costmap2D, pose, beams: int, max_range: float, rng, noise=
 
 
 class Sim:
-    """A unicycle on the house costmap with drifting odometry, a 0.25 m high laser, a clock."""
+    """A unicycle on a costmap (the house's by default) with drifting odometry, a 0.25 m high
+    laser, a clock."""
 
-    def __init__(self, params: dict, start=(0.0, 0.0, 0.0), seed=0) -> None:
+    def __init__(self, params: dict, start=(0.0, 0.0, 0.0), seed=0, costmap=None,
+                 laser_range=6.0) -> None:
         self.rng = np.random.default_rng(seed)
-        self.costmap = house_costmap()
+        self.costmap = house_costmap() if costmap is None else costmap
+        self.laser_range = laser_range
         self.t = 10.0
         self.true = np.array(start, dtype=float)
         self.odom = np.zeros(3)
@@ -98,7 +101,7 @@ class Sim:
         if correct:
             c, s = math.cos(self.true[2]), math.sin(self.true[2])
             laser = (self.true[0] + 0.1 * c, self.true[1] + 0.1 * s, self.true[2])
-            points = ray_cast(self.costmap, laser, 180, 6.0, self.rng)
+            points = ray_cast(self.costmap, laser, 180, self.laser_range, self.rng)
             self.nav_state.set("laser1", PointPerception(points, "base_laser", self.t))
             self.amcl.update(self.nav_state)
 
@@ -279,25 +282,25 @@ def test_compiled_scoring_agrees_with_the_numpy_reference():
     assert np.abs(fast - slow).mean() < 1e-4 and np.abs(fast_n - slow_n).max() <= 1
 
 
-def test_a_search_that_missed_is_tried_again_while_the_scores_stay_low(monkeypatch):
+def test_a_search_that_missed_is_tried_again(monkeypatch):
     """The first scan-to-map search after the kidnap puts its particles in the wrong place
     (forced here; seen once in ten playground runs under load). Nav2's reset after a redraw
     restarted both score averages at the lost cloud's low score, and no redraw came again:
-    the robot stayed lost. The short-term average now restarts at the long-term one, so the
-    low scores call for another search, which finds the robot."""
+    the robot stayed lost. Two seconds after a redraw the localizer searches again, finds a
+    place that fits the scan much better than the estimate, and redraws there."""
     import easynav.localizers.costmap_amcl_localizer as module
 
-    real = module.sensor_reset_poses
+    real = module.scan_match
     calls = []
 
-    def first_one_misses(costmap, points, count, *args, **kwargs):
-        poses = real(costmap, points, count, *args, **kwargs)
-        calls.append(len(poses))
-        if len(calls) == 1:
-            return np.tile((8.0, 2.5, math.pi), (len(poses), 1))  # the wrong room
-        return poses
+    def first_one_misses(costmap, points, *args, **kwargs):
+        ranked, fits = real(costmap, points, *args, **kwargs)
+        calls.append(ranked[0])
+        if len(calls) == 1:  # the wrong room
+            return np.tile((8.0, 2.5, math.pi), (len(ranked), 1)), np.full(len(fits), fits[0])
+        return ranked, fits
 
-    monkeypatch.setattr(module, "sensor_reset_poses", first_one_misses)
+    monkeypatch.setattr(module, "scan_match", first_one_misses)
     params = dict(BASE, sensor_model="likelihood_field", num_particles=500,
                   recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
                   **{"initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
@@ -307,4 +310,89 @@ def test_a_search_that_missed_is_tried_again_while_the_scores_stay_low(monkeypat
     sim.true[:] = (0.0, 5.8, 0.0)  # the north corridor, without odometry of the move
     errors = sim.drive(15.0)
     assert len(calls) >= 2  # searched again after the miss
+    assert np.mean(errors[-100:]) < 0.1, errors[::50]
+
+
+def point_symmetric_hall() -> Costmap2D:
+    """A 16 × 8 m hall whose walls and four pillars are symmetric about its centre, with
+    pallets in the east half only: the depot's layout in small. A robot in the west half has
+    a look-alike place, turned round, in the east half, which its scan of the pallets tells
+    apart (the look-alike fits 80-90 % as well)."""
+    res = 0.05
+    data = np.zeros((160, 320), np.uint8)
+
+    def block(x0, y0, x1, y1):
+        data[round(y0 / res):round(y1 / res), round(x0 / res):round(x1 / res)] = 254
+
+    block(0, 0, 16, 0.1)
+    block(0, 7.9, 16, 8)
+    block(0, 0, 0.1, 8)
+    block(15.9, 0, 16, 8)
+    for x, y in ((4, 2), (4, 6), (12, 2), (12, 6)):
+        block(x - 0.2, y - 0.2, x + 0.2, y + 0.2)
+    for x, y in ((10, 1.2), (10.2, 6.6), (13.8, 4.0)):
+        block(x - 0.5, y - 0.5, x + 0.5, y + 0.5)
+    return Costmap2D(data, res, 0.0, 0.0, "map", 1.0)
+
+
+def test_a_cloud_settled_on_a_look_alike_place_is_moved_to_the_robot(monkeypatch):
+    """The playground's depot is nearly point-symmetric. Once in about thirty runs the cloud
+    of the kidnap recovery, which held the robot's place and its mirror image, settled on the
+    mirror (which fits the scan 60-90 % as well). Its scores were then where a found robot's
+    are, so the search was not tried again, and the score averages (restarted at the lost
+    cloud's low score by the redraw) never crossed: the robot drove on 5 m from where it was
+    believed to be until the mission timed out. Forced here: the first search returns the
+    mirror place only. Two seconds later the localizer searches again; the robot's place fits
+    the scan better than the estimate by more than the margin, and the cloud is redrawn
+    there."""
+    import easynav.localizers.costmap_amcl_localizer as module
+
+    real = module.scan_match
+    calls = []
+    truth = (3.0, 3.5, math.pi)
+    mirror = (16.0 - truth[0], 8.0 - truth[1], 0.0)
+
+    def mirror_first(costmap, points, *args, **kwargs):
+        ranked, fits = real(costmap, points, *args, **kwargs)
+        calls.append(ranked[0])
+        if len(calls) == 1:
+            at_mirror = np.hypot(ranked[:, 0] - mirror[0], ranked[:, 1] - mirror[1]) < 0.5
+            assert at_mirror.any() and not at_mirror[0]  # a look-alike; the robot's place best
+            return ranked[at_mirror], fits[at_mirror]
+        return ranked, fits
+
+    monkeypatch.setattr(module, "scan_match", mirror_first)
+    params = dict(BASE, sensor_model="likelihood_field", num_particles=500,
+                  recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
+                  **{"initial_pose.x": 2.0, "initial_pose.y": 2.0,
+                     "initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
+    sim = Sim(params, start=(2.0, 2.0, 0.0), seed=8, costmap=point_symmetric_hall(),
+              laser_range=12.0)
+    sim.drive(3.0, v=0.2)
+    assert sim.error() < 0.1
+    sim.true[:] = truth  # carried, without odometry of the move
+    errors = sim.drive(10.0, v=0.0)  # turning on the spot
+    assert len(calls) >= 2
+    assert math.dist(calls[1][:2], sim.true[:2]) < 1.0  # the second search found the robot
+    assert np.mean(errors[-100:]) < 0.1, errors[::50]
+
+
+@pytest.mark.parametrize("seed", [5, 6, 9, 10])
+def test_a_robot_carried_twice_is_found_twice(seed):
+    """Carried again 12 s after it was found: Nav2's score averages both restart at the first
+    score after a redraw, the lost cloud's low one, and the long-term average (alpha 0.001)
+    stayed near it for minutes, below the short-term one: the second carry went unnoticed.
+    Corrected for their start, the averages are the scores' mean since the redraw, and the
+    second drop calls for a search as the first did."""
+    params = dict(BASE, sensor_model="likelihood_field", num_particles=500,
+                  recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
+                  **{"initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
+    sim = Sim(params, seed=seed)
+    sim.drive(4.0)
+    sim.true[:] = (0.0, 5.8, 0.0)  # the north corridor, without odometry of the move
+    errors = sim.drive(12.0)
+    assert np.mean(errors[-100:]) < 0.1, errors[::50]
+    sim.true[:] = (6.0, 2.0, 1.0)  # and into the east room
+    errors = sim.drive(12.0)
+    assert errors[0] > 4.0
     assert np.mean(errors[-100:]) < 0.1, errors[::50]

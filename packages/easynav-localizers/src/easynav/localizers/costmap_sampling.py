@@ -155,6 +155,53 @@ def refine_poses(costmap, poses: np.ndarray, points_xy: np.ndarray,
     return poses, scores
 
 
+def scan_match(
+    costmap,
+    points_xy: np.ndarray,
+    field: np.ndarray,
+    fine_field: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The poses ``(x, y, yaw)`` where the scan fits the map best, best first, with their fits
+    (the mean of ``fine_field`` under :data:`RESET_FINE_POINTS` of the points, a point off the
+    map a miss): the scan-to-map search of :func:`sensor_reset_poses`, steps 1 and 2.
+
+    Raises:
+        ValueError: no free cell, or no points.
+    """
+    if len(points_xy) == 0:
+        raise ValueError("no scan points to reset from")
+    ix, iy = free_cells(costmap)
+    step = max(1, int(round(RESET_STRIDE / costmap.resolution)))
+    keep = (ix % step == 0) & (iy % step == 0)
+    ix, iy = ix[keep], iy[keep]
+    if len(ix) == 0:
+        raise ValueError("the map has no free cell to spread particles over")
+    res = costmap.resolution
+    x = costmap.origin_x + (ix + 0.5) * res
+    y = costmap.origin_y + (iy + 0.5) * res
+    yaws = np.linspace(-math.pi, math.pi, RESET_YAW_BINS, endpoint=False)
+    candidates = np.column_stack((
+        np.repeat(x, RESET_YAW_BINS), np.repeat(y, RESET_YAW_BINS), np.tile(yaws, len(x))))
+    scores = _scores(costmap, candidates, _evenly(points_xy, RESET_POINTS), field)
+    keep_best = min(RESET_REFINED, len(candidates))
+    best = np.argpartition(-scores, keep_best - 1)[:keep_best]
+    refined, refined_scores = refine_poses(
+        costmap, candidates[best], _evenly(points_xy, RESET_FINE_POINTS),
+        field if fine_field is None else fine_field)
+    order = np.argsort(-refined_scores, kind="stable")
+    return refined[order], refined_scores[order]
+
+
+def refined_fit(costmap, pose, points_xy: np.ndarray,
+                fine_field: np.ndarray) -> tuple[np.ndarray, float]:
+    """``pose`` refined by the local search of :func:`scan_match` and its fit, on the same
+    points and field: comparable with :func:`scan_match`'s fits (how much worse the scan fits
+    where the robot is believed to be than at the best place the search found)."""
+    poses, fits = refine_poses(costmap, np.asarray(pose, dtype=float).reshape(1, 3),
+                               _evenly(np.asarray(points_xy), RESET_FINE_POINTS), fine_field)
+    return poses[0], float(fits[0])
+
+
 def sensor_reset_poses(
     costmap,
     points_xy: np.ndarray,
@@ -181,36 +228,23 @@ def sensor_reset_poses(
     3. The refined poses, best first, are repeated to ``count``, each with Gaussian noise
        ``spread`` (σ m, σ rad).
 
-    Ambiguous places (two corridors alike) all come back; the particle filter tells them apart
-    as the robot moves.
+    Steps 1 and 2 are :func:`scan_match`. Ambiguous places (two corridors alike) all come
+    back; the particle filter tells them apart as the robot moves.
 
     Raises:
         ValueError: no free cell, ``count`` < 1, or no points.
     """
     if count < 1:
         raise ValueError(f"particle count {count} must be >= 1")
-    if len(points_xy) == 0:
-        raise ValueError("no scan points to reset from")
-    ix, iy = free_cells(costmap)
-    step = max(1, int(round(RESET_STRIDE / costmap.resolution)))
-    keep = (ix % step == 0) & (iy % step == 0)
-    ix, iy = ix[keep], iy[keep]
-    if len(ix) == 0:
-        raise ValueError("the map has no free cell to spread particles over")
-    res = costmap.resolution
-    x = costmap.origin_x + (ix + 0.5) * res
-    y = costmap.origin_y + (iy + 0.5) * res
-    yaws = np.linspace(-math.pi, math.pi, RESET_YAW_BINS, endpoint=False)
-    candidates = np.column_stack((
-        np.repeat(x, RESET_YAW_BINS), np.repeat(y, RESET_YAW_BINS), np.tile(yaws, len(x))))
-    scores = _scores(costmap, candidates, _evenly(points_xy, RESET_POINTS), field)
-    keep_best = min(RESET_REFINED, len(candidates))
-    best = np.argpartition(-scores, keep_best - 1)[:keep_best]
-    refined, refined_scores = refine_poses(
-        costmap, candidates[best], _evenly(points_xy, RESET_FINE_POINTS),
-        field if fine_field is None else fine_field)
-    refined = refined[np.argsort(-refined_scores, kind="stable")]
-    picks = np.resize(refined, (count, 3))
+    refined, _ = scan_match(costmap, points_xy, field, fine_field)
+    return spread_poses(refined, count, rng, spread)
+
+
+def spread_poses(ranked: np.ndarray, count: int, rng: np.random.Generator,
+                 spread: tuple[float, float]) -> np.ndarray:
+    """``ranked`` (best first) repeated to ``count`` poses, each with Gaussian noise
+    ``spread`` (σ m, σ rad), yaw wrapped to [-π, π)."""
+    picks = np.resize(np.asarray(ranked, dtype=float), (count, 3))
     picks[:, :2] += rng.normal(0.0, spread[0], (count, 2))
     picks[:, 2] += rng.normal(0.0, spread[1], count)
     picks[:, 2] = (picks[:, 2] + math.pi) % (2.0 * math.pi) - math.pi
