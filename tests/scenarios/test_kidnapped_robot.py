@@ -92,7 +92,10 @@ def test_a_robot_carried_across_the_depot_is_found_and_finishes_its_mission(tmp_
         if max(first, since) <= t <= min(last, ended_at)
     ]
     assert errors.size == len(stamps) and errors.size > 50
-    assert float(errors[:5].min()) > 2.0, errors[:5]
+    # The first estimate after the carry only: the recovery takes a second or more (the
+    # short-term score average has to fall first), but under load the estimates recorded can
+    # be 1.4 s apart, and the fifth was once already on the robot (found 2.4 s after the carry).
+    assert float(errors[0]) > 2.0, (stamps[0] - carried_at, errors[:5])
     # Found: the estimate settles on the robot and stays there to the end. The redraw puts
     # particles at the robot and at the depot's look-alike places (the hall is nearly
     # point-symmetric), and the estimate may sit at one, then the other, for a second or two,
