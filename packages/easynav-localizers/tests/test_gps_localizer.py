@@ -260,7 +260,8 @@ def test_a_handover_between_fixes_leaves_no_bias():
     plugin.add_fix(_fix(projection, 2.0, 0.0, 2.0))
     nav_state = NavState()
     plugin.update(nav_state)
-    assert nav_state.get("robot_pose", Odometry).pose.x == pytest.approx(2.0, abs=1e-3)
+    pose = nav_state.get("robot_pose", Odometry)  # the fix of t = 2 carried on to t = 2.4
+    assert (pose.pose.x, pose.header.stamp) == pytest.approx((2.4, 2.4), abs=1e-3)
     _, (tx, *_r) = buffer.lookup_transform_values("map", "base_footprint")  # t = 2.4
     assert tx == pytest.approx(2.4, abs=1e-3)
 
@@ -336,3 +337,28 @@ def test_a_handover_measures_the_estimate_where_odometry_can(case):
     nav_state = NavState()
     plugin.update(nav_state)
     assert nav_state.get("robot_pose", Odometry).pose.x == pytest.approx(expected, abs=1e-3)
+
+
+def test_robot_pose_moves_on_with_odometry_between_fixes_and_through_an_outage():
+    """Odometry every 0.1 s (x = t, 1 m/s); fixes at 5 Hz up to t = 1, then none up to t = 4
+    (an outage). robot_pose is the last fix carried on by odometry to the newest odom -> robot,
+    stamped there, with its position variance grown by 5 % of the way driven since the fix; the
+    original wrote the last fix, which stood 3 m behind the robot at the end of the outage."""
+    from easynav.common.tf import get_tf_buffer
+    from easynav.localizers.gps_localizer import ODOMETRY_DRIFT
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin({"initial_pose.x": 10.0, "initial_pose.y": 5.0}, "gps_test_carried")
+    buffer = get_tf_buffer("gps_test_carried")
+    nav_state = NavState()
+    for k in range(0, 41):
+        t = 0.1 * k
+        _odometry_line(buffer, [t])
+        if k <= 10 and k % 2 == 0:
+            plugin.add_fix(_fix(projection, t, 0.0, t, sigma=0.15))
+        plugin.update(nav_state)
+        pose = nav_state.get("robot_pose", Odometry)
+        assert (pose.pose.x, pose.pose.y) == pytest.approx((10.0 + t, 5.0), abs=1e-3), t
+        assert pose.header.stamp == pytest.approx(t)
+    driven = 3.0  # since the fix of t = 1
+    assert pose.pose_covariance[0, 0] == pytest.approx(0.15**2 + (ODOMETRY_DRIFT * driven)**2)
