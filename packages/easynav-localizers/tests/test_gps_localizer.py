@@ -340,10 +340,11 @@ def test_a_handover_measures_the_estimate_where_odometry_can(case):
 
 
 def test_robot_pose_moves_on_with_odometry_between_fixes_and_through_an_outage():
-    """Odometry every 0.1 s (x = t, 1 m/s); fixes at 5 Hz up to t = 1, then none up to t = 4
-    (an outage). robot_pose is the last fix carried on by odometry to the newest odom -> robot,
-    stamped there, with its position variance grown by 5 % of the way driven since the fix; the
-    original wrote the last fix, which stood 3 m behind the robot at the end of the outage."""
+    """Odometry every 0.1 s (x = t, 1 m/s); fixes at 5 Hz up to t = 1, then none up to t = 16
+    (an outage longer than TF's 10 s of history). robot_pose is the last fix carried on by
+    odometry to the newest odom -> robot, stamped there, its position variance grown by 5 % of
+    the way odometry measured since the fix, never falling back through the outage; the
+    original wrote the last fix, which stood 15 m behind the robot at the end of it."""
     from easynav.common.tf import get_tf_buffer
     from easynav.localizers.gps_localizer import ODOMETRY_DRIFT
 
@@ -351,7 +352,8 @@ def test_robot_pose_moves_on_with_odometry_between_fixes_and_through_an_outage()
     plugin = _plugin({"initial_pose.x": 10.0, "initial_pose.y": 5.0}, "gps_test_carried")
     buffer = get_tf_buffer("gps_test_carried")
     nav_state = NavState()
-    for k in range(0, 41):
+    variances = []
+    for k in range(0, 161):
         t = 0.1 * k
         _odometry_line(buffer, [t])
         if k <= 10 and k % 2 == 0:
@@ -360,5 +362,50 @@ def test_robot_pose_moves_on_with_odometry_between_fixes_and_through_an_outage()
         pose = nav_state.get("robot_pose", Odometry)
         assert (pose.pose.x, pose.pose.y) == pytest.approx((10.0 + t, 5.0), abs=1e-3), t
         assert pose.header.stamp == pytest.approx(t)
-    driven = 3.0  # since the fix of t = 1
-    assert pose.pose_covariance[0, 0] == pytest.approx(0.15**2 + (ODOMETRY_DRIFT * driven)**2)
+        variances.append(pose.pose_covariance[0, 0])
+    assert variances[-1] == pytest.approx(0.15**2 + (ODOMETRY_DRIFT * 15.0)**2)
+    assert np.all(np.diff(variances[10:]) >= 0.0)
+
+
+def test_the_way_driven_counts_a_drive_there_and_back():
+    """After the fix, odometry drives 2 m on and 2 m back: the variance grows for 4 m, where the
+    displacement (0) would claim the pose as sure as the fix."""
+    from easynav.common.tf import get_tf_buffer
+    from easynav.localizers.gps_localizer import ODOMETRY_DRIFT
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace="gps_test_there_and_back")
+    buffer = get_tf_buffer("gps_test_there_and_back")
+    nav_state = NavState()
+    buffer.set_transform_values("odom", "base_footprint", 0.0, (0, 0, 0, 0, 0, 0, 1), "test")
+    plugin.add_fix(_fix(projection, 0.0, 0.0, 0.0, sigma=0.15))
+    plugin.update(nav_state)
+    for k in range(1, 41):
+        x = 0.1 * k if k <= 20 else 0.1 * (40 - k)
+        buffer.set_transform_values("odom", "base_footprint", 0.1 * k, (x, 0, 0, 0, 0, 0, 1),
+                                    "test")
+        plugin.update(nav_state)
+    pose = nav_state.get("robot_pose", Odometry)
+    assert pose.pose.x == pytest.approx(0.0, abs=1e-6)
+    assert pose.pose_covariance[0, 0] == pytest.approx(0.15**2 + (ODOMETRY_DRIFT * 4.0)**2)
+
+
+def test_an_unstamped_fix_is_carried_from_the_odometry_it_was_anchored_on():
+    """A fix without a stamp is anchored on the newest odometry; robot_pose moves on from
+    there and its variance grows with the way driven after it."""
+    from easynav.common.tf import get_tf_buffer
+    from easynav.localizers.gps_localizer import ODOMETRY_DRIFT
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin(namespace="gps_test_unstamped_carry")
+    buffer = get_tf_buffer("gps_test_unstamped_carry")
+    nav_state = NavState()
+    _odometry_line(buffer, [0.0, 0.1, 0.2])
+    plugin.add_fix(_fix(projection, 0.0, 0.0, 0.0, sigma=0.15))
+    plugin.update(nav_state)  # anchored on odometry's x = 0.2
+    for k in range(3, 13):
+        _odometry_line(buffer, [0.1 * k])
+        plugin.update(nav_state)
+    pose = nav_state.get("robot_pose", Odometry)
+    assert pose.pose.x == pytest.approx(1.0, abs=1e-6)
+    assert pose.pose_covariance[0, 0] == pytest.approx(0.15**2 + (ODOMETRY_DRIFT * 1.0)**2)

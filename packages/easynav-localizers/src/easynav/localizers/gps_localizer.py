@@ -140,6 +140,9 @@ class GpsLocalizer(LocalizerMethodBase):
         self._reported_releases = 0
         #: map → odom as last anchored: (the estimator's fixes_taken then, tx, ty, yaw).
         self._anchor: tuple[int, float, float, float] | None = None
+        #: The way odometry measured since the anchor's fix: (fixes_taken, x, y of the last
+        #: odometry counted, metres so far), for robot_pose's variance.
+        self._driven: tuple[int, float, float, float] | None = None
         self._sent_stamp = -math.inf
 
     def on_initialize(self) -> None:
@@ -149,7 +152,7 @@ class GpsLocalizer(LocalizerMethodBase):
             self.estimator = GpsPoseEstimator(v["initial_pose.x"], v["initial_pose.y"],
                                               gate_speed=v.fix_gate_speed)
             self._reported_rejections = self._reported_releases = 0
-            self._anchor, self._sent_stamp = None, -math.inf
+            self._anchor, self._sent_stamp, self._driven = None, -math.inf, None
         if self.context.node is not None:
             self._create_ros()
 
@@ -184,6 +187,8 @@ class GpsLocalizer(LocalizerMethodBase):
             self._anchor = None if odom is None else (
                 self.estimator.fixes_taken, *_anchor_on((pose.pose.x, pose.pose.y, pose.pose.yaw),
                                                         odom, odom[2]))
+            self._driven = None if odom is None else (
+                self.estimator.fixes_taken, odom[0], odom[1], 0.0)
 
     def _estimate_at(self, stamp: float) -> tuple[float, float] | None:
         """Where the estimate puts the robot at ``stamp``: the current anchor with odometry
@@ -217,8 +222,9 @@ class GpsLocalizer(LocalizerMethodBase):
     def update(self, nav_state: NavState) -> None:
         """Broadcast ``map → odom`` from the last fix and IMU reading (once a fix arrived) and
         write ``robot_pose``: that estimate carried on by odometry to the newest
-        ``odom → robot`` (:meth:`_carried`), or the fix as it is without odometry."""
-        with self._lock:
+        ``odom → robot`` (:meth:`_carried`), or the fix as it is while ``map → odom`` has no
+        anchor on it (no odometry yet, or a fix ahead of odometry waiting for it)."""
+        with self._lock:  # the anchor too: a handover between the two would be undone
             e = self.estimator
             if e.position is None:
                 self._throttle.warn(self.logger, "no-fix", f"{self.plugin_name}: no GNSS fix yet")
@@ -229,12 +235,11 @@ class GpsLocalizer(LocalizerMethodBase):
             roll, pitch, yaw, stamp = e.roll, e.pitch, e.yaw, e.stamp
             covariance = e.covariance6()
             angular_velocity = e.angular_velocity.copy()
-        self._send_map_to_odom(*fix)
+            self._send_map_to_odom(*fix)
+            carried = self._carried(fix[6])
         x, y = fix[0], fix[1]
-        carried = self._carried(fix[2], fix[6])
         if carried is not None:
-            x, y, odom_stamp, driven = carried
-            stamp = max(stamp, odom_stamp)
+            x, y, stamp, driven = carried
             covariance[:2, :2] += np.eye(2) * (ODOMETRY_DRIFT * driven) ** 2
         qx, qy, qz, qw = _rpy_quaternion(roll, pitch, yaw)
         tf_info = get_tf_buffer(self.context.namespace).get_tf_info()
@@ -252,14 +257,14 @@ class GpsLocalizer(LocalizerMethodBase):
 
             publisher.publish(odometry_to_msg(odometry))
 
-    def _carried(self, fix_stamp: float,
-                 taken: int) -> tuple[float, float, float, float] | None:
+    def _carried(self, taken: int) -> tuple[float, float, float, float] | None:
         """The robot's position in the map at the newest ``odom → robot``: ``map → odom`` as
-        anchored on fix number ``taken`` (:meth:`_send_map_to_odom`) composed with it, that
-        odometry's stamp, and the way (m) odometry measured since the fix. None when the anchor
-        is not that fix's (a fix ahead of odometry waits for it), or without odometry."""
-        anchor = self._anchor
-        if anchor is None or anchor[0] != taken:
+        anchored on fix number ``taken`` (:meth:`_send_map_to_odom`, or a handover since)
+        composed with it; that odometry's stamp; the way (m) odometry measured since the
+        anchor, summed update by update (a drive there and back drifts as much as one on).
+        None when the anchor is not that fix's, or without odometry. Under the lock."""
+        anchor, driven = self._anchor, self._driven
+        if anchor is None or anchor[0] != taken or driven is None or driven[0] != taken:
             return None
         buffer = get_tf_buffer(self.context.namespace)
         tf_info = buffer.get_tf_info()
@@ -269,9 +274,9 @@ class GpsLocalizer(LocalizerMethodBase):
         except LookupError:
             return None
         x, y, _ = _compose(anchor[1:], (ox, oy, quaternion_to_yaw(*q)))
-        at_fix = self._odometry_at(fix_stamp) if fix_stamp > 0.0 else None
-        driven = 0.0 if at_fix is None else math.hypot(ox - at_fix[0], oy - at_fix[1])
-        return x, y, newest, driven
+        way = driven[3] + math.hypot(ox - driven[1], oy - driven[2])
+        self._driven = (taken, ox, oy, way)
+        return x, y, newest, way
 
     def _report_gate(self, e: GpsPoseEstimator) -> None:
         """Throttled warnings for the fixes the jump gate rejected, and for a far fix taken
@@ -326,7 +331,7 @@ class GpsLocalizer(LocalizerMethodBase):
                                 f"{self.plugin_name}: no map → odom: {exc}")
             return
         if newest < self._sent_stamp - CLOCK_JUMP:  # the clock went back: start again
-            self._sent_stamp, self._anchor = -math.inf, None
+            self._sent_stamp, self._anchor, self._driven = -math.inf, None, None
         ahead = fix_stamp - newest
         if (self._anchor is None or self._anchor[0] != taken) and (
                 ahead <= 0.0 or ahead > ODOMETRY_WAIT or fix_stamp <= 0.0):
@@ -349,6 +354,7 @@ class GpsLocalizer(LocalizerMethodBase):
             if not all(math.isfinite(v) for v in anchor):
                 return
             self._anchor = (taken, *anchor)
+            self._driven = (taken, odom[0], odom[1], 0.0)
         # Stamped with the newest odometry, never ahead of it: a transform ahead of the rest
         # of the tree (a fix on another clock, odometry stalled, a fix left from before a
         # restart) made every lookup through map fail.

@@ -22,7 +22,7 @@ VOXEL_MAPS_MANAGERS = {
 }
 #: Localizers scored from the Odometry topic (map frame) they publish rather than from TF: the
 #: original's GpsLocalizer broadcast an identity ``map -> odom`` (TF scored the odometry); ours
-#: follows its estimate, but only at each fix, so its own topic is still the estimate itself.
+#: follows its estimate, and its topic is the estimate itself (with the IMU filter's heading).
 ESTIMATE_TOPICS = {"easynav_gps_localizer/GpsLocalizer": "/robot/odom_gps"}
 
 

@@ -47,7 +47,7 @@ class RunMonitor(Node):
     - ``estimate_topic`` instead, when given: the localizer's pose (an Odometry in the map
       frame) for a localizer scored from its own topic (the GpsLocalizer: the original's
       map -> odom was a static identity, and composing it with odometry scored the odometry;
-      ours follows the fixes, and its topic is still the estimate itself);
+      ours follows the estimate, and its topic is the estimate itself);
     - with a ``frame_prefix`` (one robot of several, the node in the robot's namespace): its
       own ``tf`` (``/r1/tf``) instead, the frames prefixed (``r1/map``...), and every frame
       seen there without the prefix is kept in :attr:`foreign_frames` (a crossed tree);
