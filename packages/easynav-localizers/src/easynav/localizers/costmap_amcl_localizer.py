@@ -40,23 +40,31 @@ HIT_COUNT = "hit_count"
 #: Sensor resetting searches only when at least this share of the cloud is redrawn (the
 #: scores fell markedly): the search costs ~0.15 s of the non-RT thread on a 30 × 15 m map.
 RESET_MIN_SHARE = 0.1
-#: A kidnap episode (a redraw from the search) searches again every SEARCH_RETRY_PERIOD s
-#: and redraws again (at most SEARCH_RETRIES times) while the cloud is on a look-alike: the
-#: search's best place for the scan is elsewhere (LOOKALIKE_DISTANCE m or LOOKALIKE_TURN rad
-#: from the estimate) and fits it better than the estimate does, both refined, by more than
-#: LOOKALIKE_MARGIN of its fit. The episode ends when the estimate fits as well as any place.
-#: Measured without ROS on the depot (96 poses, 360 beams, range noise 1-5 cm): the true pose
-#: fits 0.99-1.01 of the best place's fit, the hall's mirror image 0.30-0.93.
+#: A kidnap episode (a redraw from the search) is checked at the first reseed at least
+#: SEARCH_RETRY_PERIOD s after its last search, and redraws again (at most SEARCH_RETRIES
+#: times) while the cloud is on a wrong place: the search finds a place elsewhere
+#: (LOOKALIKE_DISTANCE m or LOOKALIKE_TURN rad from the estimate) that fits the scan better
+#: than the estimate does, both refined, by more than LOOKALIKE_MARGIN of its fit; and the
+#: robot was carried (at the episode's first search the best place fitted the scan more than
+#: SEARCH_LOST_DROP better than the cloud's place), or the scores are still more than
+#: SEARCH_LOST_DROP below their level before the drop. Otherwise the episode ends. Measured
+#: without ROS on the depot (96 poses, 360 beams, range noise 1-5 cm): the true pose fits
+#: 0.99-1.01 of the best place's fit, the hall's mirror image 0.30-0.93 of it. Why not the
+#: search alone: where the world differs from the map (pallets moved), a robot on its true
+#: place may fit 7 % worse than a look-alike, and a few noisy scans that dip its scores would
+#: have its cloud carried there; noise lowers every place's fit alike, a carry only the
+#: cloud's.
 SEARCH_RETRY_PERIOD = 2.0
 SEARCH_RETRIES = 5
+SEARCH_LOST_DROP = 0.3
 LOOKALIKE_MARGIN = 0.05
 LOOKALIKE_DISTANCE = 1.0
 LOOKALIKE_TURN = 0.5
-#: A redraw after the check found a look-alike: at least this share of the cloud (its least
-#: likely particles), at the places that fit within LOOKALIKE_MARGIN of the best only. The
-#: likelihood field scores a look-alike 90 % as well as the robot's place: 14 % of the cloud
-#: redrawn at the robot's place (and its look-alikes) still held 17 % of the weight a second
-#: later, and the estimate stayed on the look-alike through five redraws.
+#: A redraw after the check found the cloud on a wrong place: at least this share of the cloud
+#: (its least likely particles), at the places that fit within LOOKALIKE_MARGIN of the best
+#: only. The likelihood field scores a look-alike up to 90 % as well as the robot's place: 14 %
+#: of the cloud redrawn at the robot's place (and its look-alikes) still held 17 % of the
+#: weight a second later, and the estimate stayed on the look-alike through five redraws.
 LOOKALIKE_SHARE = 0.5
 LIKELIHOOD_FIELD = "likelihood_field"
 
@@ -65,10 +73,18 @@ LIKELIHOOD_FIELD = "likelihood_field"
 class _KidnapEpisode:
     """Redraws from the search since the scores fell (see :data:`SEARCH_RETRY_PERIOD`)."""
 
+    reference: float  # w_slow before the first redraw: how well the scan fitted before
+    carried: bool  # at the first search, the best place fitted SEARCH_LOST_DROP better
     share: float  # the first redraw's share of the cloud
     last_search: float  # s (node clock)
     retries: int = 0
     retry_due: bool = False  # the check found a look-alike: redraw LOOKALIKE_SHARE there
+
+
+def _seen_share(alpha: float, n: int) -> float:
+    """``1 - (1 - alpha)^n``: the weight an exponential average started at 0 has given its
+    first ``n`` values (exact for tiny ``alpha``, where the power rounds to 1)."""
+    return -math.expm1(n * math.log1p(-alpha)) if alpha < 1.0 else 1.0
 
 
 class CostmapAMCLLocalizer(AMCLLocalizer):
@@ -180,10 +196,12 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._w_fast = 0.0
         self._scores_seen = 0  # since the averages last restarted
         self._slow_sum = self._fast_sum = 0.0  # the averages before their start-up correction
+        self._carried = False  # the last search's verdict, for the episode it starts
         self._episode: _KidnapEpisode | None = None  # searches since the scores fell
         self._reset_map: Costmap2D | None = None
         self._reset_fields: tuple[np.ndarray, np.ndarray] | None = None
         self._reset_poses: np.ndarray | None = None  # ranked, best first; None: uniform redraws
+        self._redrawn = False  # _inject_random redrew in this update: no reseed after it
 
     # -- configuration ------------------------------------------------------------------------
     def on_initialize(self) -> None:
@@ -296,7 +314,8 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         now = self.now()
         self._track_scores(score)
         reseed_due = now - self._last_reseed >= self.reseed_period or now < self._last_reseed
-        self._prepare_sensor_reset(base, points, weights, reseed_due, now)
+        self._prepare_sensor_reset(base, points, weights, reseed_due, now, score)
+        self._redrawn = False
         with self._lock:
             if generation == self._generation:  # not redrawn (initialpose) while scoring
                 self._apply(weights, base)
@@ -397,8 +416,8 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         n = self._scores_seen
         self._slow_sum += p.recovery_alpha_slow * (score - self._slow_sum)
         self._fast_sum += p.recovery_alpha_fast * (score - self._fast_sum)
-        self._w_slow = self._slow_sum / (1.0 - (1.0 - p.recovery_alpha_slow) ** n)
-        self._w_fast = self._fast_sum / (1.0 - (1.0 - p.recovery_alpha_fast) ** n)
+        self._w_slow = self._slow_sum / _seen_share(p.recovery_alpha_slow, n)
+        self._w_fast = self._fast_sum / _seen_share(p.recovery_alpha_fast, n)
 
     def _restart_scores(self) -> None:
         """Both averages start again from the next score (Nav2's reset after a redraw)."""
@@ -416,13 +435,15 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         return share
 
     def _prepare_sensor_reset(self, base: Costmap2D, points: np.ndarray,
-                              weights: np.ndarray, reseed_due: bool, now: float) -> None:
+                              weights: np.ndarray, reseed_due: bool, now: float,
+                              score: float) -> None:
         """When this update will redraw particles (a reseed, or a likelihood-field resample)
         and the scores fell, or a kidnap episode's check is due (:meth:`_check_episode`), rank
-        the poses where this scan fits the map, for :meth:`_inject_random`. Outside the lock:
-        the search takes tens of milliseconds and the compiled scoring releases the GIL, so
-        the RT loop runs meanwhile. Computed for this update's scan only: a ranking kept for
-        a later update would place the particles where the robot was."""
+        the poses where this scan fits the map, for :meth:`_inject_random`, and compare the
+        best with the cloud's estimate. Outside the lock: the search takes tens of
+        milliseconds and the compiled scoring releases the GIL, so the RT loop runs
+        meanwhile. Computed for this update's scan only: a ranking kept for a later update
+        would place the particles where the robot was."""
         self._reset_poses = None
         if not self.params.recovery_sensor_resetting:
             return
@@ -446,47 +467,68 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             self._reset_fields = (likelihood_field(base, RESET_STRIDE),
                                   likelihood_field(base, RESET_FINE_SIGMA))
             self._reset_map = base
+        with self._lock:  # before the search: after it, the RT loop has moved it on ~0.15 s
+            estimate = self.filter.estimate()
         try:
             ranked, fits = scan_match(base, points, *self._reset_fields)
         except ValueError:
             return
+        here, fit = refined_fit(base, estimate, points, self._reset_fields[1])
+        best, best_fit = ranked[0], float(fits[0])
+        turn = abs((best[2] - here[2] + math.pi) % (2.0 * math.pi) - math.pi)
+        elsewhere = (math.hypot(best[0] - here[0], best[1] - here[1]) > LOOKALIKE_DISTANCE
+                     or turn > LOOKALIKE_TURN)
+        self._carried = elsewhere and fit < (1.0 - SEARCH_LOST_DROP) * best_fit
+        if elsewhere and not self._carried and not check_due:
+            # The scores fell, but no place fits the scan clearly better than the cloud's: the
+            # best is a look-alike, a little better where the world differs from the map (two
+            # pallets moved: 7 %), or a few noisy scans dipped every place's fit. Redrawn there,
+            # the cloud of a robot that had not moved followed the look-alike (9 m, 3 seeds of
+            # 4). Nothing is redrawn; the averages restart, as after a redraw, so that the
+            # search is not run again at every reseed while the dip lasts.
+            self._restart_scores()
+            self._throttle.warn(
+                self.logger, "no-better-place",
+                f"{self.plugin_name}: the scores fell, but the scan fits no place clearly "
+                f"better than the estimate (best ({best[0]:.2f}, {best[1]:.2f}): {best_fit:.2f} "
+                f"against {fit:.2f}): nothing redrawn")
+            return
         if check_due:
-            self._check_episode(base, points, ranked[0], fits[0], now)
+            lookalike = elsewhere and fit < (1.0 - LOOKALIKE_MARGIN) * best_fit
+            self._check_episode(lookalike, best, best_fit, here, fit, now, score)
             if self._episode is not None and self._episode.retry_due:
-                ranked = ranked[fits >= (1.0 - LOOKALIKE_MARGIN) * fits[0]]
+                ranked = ranked[fits >= (1.0 - LOOKALIKE_MARGIN) * best_fit]
             elif self._recovery_share() < RESET_MIN_SHARE:
                 return
         self._reset_poses = spread_poses(ranked, len(weights), self.filter.rng,
                                          (self.min_noise_xy, self.min_noise_yaw))
 
-    def _check_episode(self, base: Costmap2D, points: np.ndarray, best: np.ndarray,
-                       best_fit: float, now: float) -> None:
-        """A kidnap episode's check, :data:`SEARCH_RETRY_PERIOD` s after its last search:
-        is the cloud on a look-alike? Then a redraw is due (``retry_due``: at least
-        :data:`LOOKALIKE_SHARE` of the cloud, at the places that fit this scan within
-        :data:`LOOKALIKE_MARGIN` of the best); else the episode ends (the robot is found, or it was
-        never lost: a place that fits the map a little worse). Why not the scores: a
-        look-alike place fits the scan almost as well as the robot's (the depot's mirror
-        image 60-90 %), as well as the robot's place fits where the map is less exact, and
-        the filter, whose cloud held both places after the redraw, settled on the mirror in
-        one playground run in about thirty; the scores then stayed where a found robot's are.
-        The check compares places on the same scan instead: the estimate refined against the
-        search's best."""
+    def _check_episode(self, lookalike: bool, best: np.ndarray, best_fit: float,
+                       here: np.ndarray, fit: float, now: float, score: float) -> None:
+        """A kidnap episode's check (:data:`SEARCH_RETRY_PERIOD`): is the cloud on a wrong
+        place? Then a redraw is due (``retry_due``: at least :data:`LOOKALIKE_SHARE` of the
+        cloud, at the places that fit this scan within :data:`LOOKALIKE_MARGIN` of the best);
+        else the episode ends (the robot is found, or was never lost).
+
+        ``lookalike``: the search's ``best`` (fit ``best_fit``) is elsewhere and fits the scan
+        more than the margin better than the refined estimate ``here`` (``fit``). The scores
+        alone did not tell: a look-alike fits the scan almost as well as the robot's place
+        (the depot's mirror image, up to 93 %), and the filter, whose cloud held both places
+        after the redraw, settled on the mirror in one playground run in about thirty. The
+        search alone did not either: with pallets moved, a robot on its true place fitted 7 %
+        worse than its mirror image, and after a few noisy scans dipped its scores, three
+        redraws carried its cloud there. So it acts for a carried robot
+        (:attr:`_KidnapEpisode.carried`) or one whose scores are still low."""
         episode = self._episode
         episode.last_search = now
-        with self._lock:
-            estimate = self.filter.estimate()
-        here, fit = refined_fit(base, estimate, points, self._reset_fields[1])
-        turn = abs((best[2] - here[2] + math.pi) % (2.0 * math.pi) - math.pi)
-        elsewhere = (math.hypot(best[0] - here[0], best[1] - here[1]) > LOOKALIKE_DISTANCE
-                     or turn > LOOKALIKE_TURN)
-        if elsewhere and fit < (1.0 - LOOKALIKE_MARGIN) * best_fit:
+        lost = score < (1.0 - SEARCH_LOST_DROP) * episode.reference
+        if lookalike and (episode.carried or lost):
             if episode.retries < SEARCH_RETRIES:
                 episode.retry_due = True
                 self.logger.info(
                     f"{self.plugin_name}: the scan fits ({best[0]:.2f}, {best[1]:.2f}, "
                     f"{best[2]:.2f}) better than the estimate ({here[0]:.2f}, {here[1]:.2f}, "
-                    f"{here[2]:.2f}): {best_fit:.2f} against {fit:.2f}; redrawing there again")
+                    f"{here[2]:.2f}): {best_fit:.2f} against {fit:.2f}; redrawing there")
                 return
             self.logger.warning(
                 f"{self.plugin_name}: the scan still fits ({best[0]:.2f}, {best[1]:.2f}) "
@@ -526,9 +568,11 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             injected = self._resample(base)
         else:
             injected = self._inject_random(base)
-        # Not right after a redraw: the new particles have not been weighed yet, sit among the
-        # worse half, and the reseed would draw them back onto the old (wrong) cloud.
-        if not injected:
+        # Not right after a redraw, this one or the likelihood-field resample's of this update:
+        # the new particles have not been weighed yet. After a resample every weight is equal,
+        # and the reseed's "upper half" was the redrawn half, copied over the rest: the whole
+        # cloud went to the search's places.
+        if not injected and not self._redrawn:
             self.filter.reseed_worst_half(self.min_noise_xy, self.min_noise_yaw)
         self._generation += 1  # hit counters restart with the new cloud
 
@@ -549,7 +593,11 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             # a marked drop without a search for this scan waits for the next update. A
             # uniform redraw would spend the averages' reset and end the recovery.
             return False
-        order = np.argsort(self.filter.weights, kind="stable")[:count]  # the least likely
+        # The least likely, ties in random order: after a resample every weight is equal, and
+        # resampling keeps each place's copies in a run of indices (the first ``count`` could
+        # be one whole place).
+        shuffled = self.filter.rng.permutation(len(self.filter))
+        order = shuffled[np.argsort(self.filter.weights[shuffled], kind="stable")][:count]
         if ranked is not None:
             poses, where = np.resize(ranked, (count, 3)), "where the scan fits the map"
         else:
@@ -559,9 +607,12 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
                 return False
             where = "over the free space"
         self.filter.redraw(order, poses)
+        self._redrawn = True
         if ranked is not None:
             if self._episode is None:
-                self._episode = _KidnapEpisode(share=share, last_search=self.now())
+                self._episode = _KidnapEpisode(
+                    reference=self._w_slow, share=share, last_search=self.now(),
+                    carried=self._carried)
             else:
                 self._episode.retries += 1
                 self._episode.last_search = self.now()
@@ -573,6 +624,14 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self.logger.info(f"{self.plugin_name}: {count} particles redrawn {where} "
                          f"(scores fell: kidnapped?)")
         return True
+
+    def reset_pose(self, x: float, y: float, yaw: float, cov_xy: np.ndarray,
+                   var_yaw: float) -> None:
+        """The shared reset (``initialpose``, a handover); a kidnap episode ends and the score
+        averages start again (Nav2's ``pf_init``): the pose given overrides the search's."""
+        super().reset_pose(x, y, yaw, cov_xy, var_yaw)
+        self._episode = None
+        self._restart_scores()
 
     def _spread_globally(self, base: Costmap2D) -> None:
         p = self.params
