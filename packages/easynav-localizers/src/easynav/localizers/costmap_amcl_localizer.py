@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,23 +41,30 @@ HIT_COUNT = "hit_count"
 #: Sensor resetting searches only when at least this share of the cloud is redrawn (the
 #: scores fell markedly): the search costs ~0.15 s of the non-RT thread on a 30 × 15 m map.
 RESET_MIN_SHARE = 0.1
-#: A kidnap episode (a redraw from the search) is checked at the first reseed at least
-#: SEARCH_RETRY_PERIOD s after its last search, and redraws again (at most SEARCH_RETRIES
-#: times) while the cloud is on a wrong place: the search finds a place elsewhere
-#: (LOOKALIKE_DISTANCE m or LOOKALIKE_TURN rad from the estimate) that fits the scan better
-#: than the estimate does, both refined, by more than LOOKALIKE_MARGIN of its fit; and the
-#: robot was carried (at the episode's first search the best place fitted the scan more than
-#: SEARCH_LOST_DROP better than the cloud's place), or the scores are still more than
-#: SEARCH_LOST_DROP below their level before the drop. Otherwise the episode ends. Measured
-#: without ROS on the depot (96 poses, 360 beams, range noise 1-5 cm): the true pose fits
-#: 0.99-1.01 of the best place's fit, the hall's mirror image 0.30-0.93 of it. Why not the
-#: search alone: where the world differs from the map (pallets moved), a robot on its true
-#: place may fit 7 % worse than a look-alike, and a few noisy scans that dip its scores would
-#: have its cloud carried there; noise lowers every place's fit alike, a carry only the
-#: cloud's.
+#: Each search compares its best place with the cloud's estimate (both refined). The robot
+#: was carried when the best is elsewhere (LOOKALIKE_DISTANCE m or LOOKALIKE_TURN rad away)
+#: and the estimate fits the scan less than (1 - SEARCH_LOST_DROP) of the best's fit, or the
+#: score fell below CARRIED_DROP of the long-term average. A redraw from the scores' drop goes
+#: ahead for a carried robot or when the best is the cloud's own place; a place elsewhere that
+#: is better but not clearly so (a look-alike where the world differs from the map: two
+#: pallets moved, 7 %; or a few noisy scans that lowered every place's fit) gets nothing, and
+#: the averages restart. A kidnap episode (a redraw from the search) is checked at the first
+#: reseed at least SEARCH_RETRY_PERIOD s after its last search, and redraws again (at most
+#: SEARCH_RETRIES times) when the best is elsewhere and fits the scan better than the estimate
+#: by more than LOOKALIKE_MARGIN of its fit, and the robot was carried or its scores are
+#: still more than SEARCH_LOST_DROP below their level before the drop. Otherwise the episode
+#: ends. Measured without ROS on the depot (96 poses, 360 beams, range noise 1-5 cm): the
+#: true pose fits 0.99-1.01 of the best place's fit, the hall's mirror image 0.30-0.93 of it.
 SEARCH_RETRY_PERIOD = 2.0
 SEARCH_RETRIES = 5
 SEARCH_LOST_DROP = 0.3
+#: A carried robot's scores fall by half at once (to 0.38-0.43 of their level in the
+#: symmetric hall of the tests, carried onto its cloud's mirror image, where one scan cannot
+#: tell the carry from a changed world; 0.68 for two seconds of scans with 15 cm noise): the
+#: lowest score of the last CARRIED_WINDOW s against the long-term average (the cloud settles
+#: on the best local fit within a second, and the score rises again before the search).
+CARRIED_DROP = 0.5
+CARRIED_WINDOW = 2.0
 LOOKALIKE_MARGIN = 0.05
 LOOKALIKE_DISTANCE = 1.0
 LOOKALIKE_TURN = 0.5
@@ -74,7 +82,7 @@ class _KidnapEpisode:
     """Redraws from the search since the scores fell (see :data:`SEARCH_RETRY_PERIOD`)."""
 
     reference: float  # w_slow before the first redraw: how well the scan fitted before
-    carried: bool  # at the first search, the best place fitted SEARCH_LOST_DROP better
+    carried: bool  # the first search's verdict (see CARRIED_DROP)
     share: float  # the first redraw's share of the cloud
     last_search: float  # s (node clock)
     retries: int = 0
@@ -197,6 +205,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._scores_seen = 0  # since the averages last restarted
         self._slow_sum = self._fast_sum = 0.0  # the averages before their start-up correction
         self._carried = False  # the last search's verdict, for the episode it starts
+        self._recent_scores: deque[tuple[float, float]] = deque()  # (time, score), 2 s
         self._episode: _KidnapEpisode | None = None  # searches since the scores fell
         self._reset_map: Costmap2D | None = None
         self._reset_fields: tuple[np.ndarray, np.ndarray] | None = None
@@ -219,6 +228,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._field_map = self._field = None
         self._lf_map = self._lf_field = None
         self._restart_scores()
+        self._recent_scores.clear()
         self._episode = None
         self._reset_poses = None
         with self._lock:
@@ -313,6 +323,10 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             weights, score = self._hit_count_weights(snapshot, points, base, generation)
         now = self.now()
         self._track_scores(score)
+        recent = self._recent_scores
+        recent.append((now, score))
+        while recent and (now - recent[0][0] > CARRIED_WINDOW or now < recent[0][0]):
+            recent.popleft()
         reseed_due = now - self._last_reseed >= self.reseed_period or now < self._last_reseed
         self._prepare_sensor_reset(base, points, weights, reseed_due, now, score)
         self._redrawn = False
@@ -478,8 +492,20 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         turn = abs((best[2] - here[2] + math.pi) % (2.0 * math.pi) - math.pi)
         elsewhere = (math.hypot(best[0] - here[0], best[1] - here[1]) > LOOKALIKE_DISTANCE
                      or turn > LOOKALIKE_TURN)
-        self._carried = elsewhere and fit < (1.0 - SEARCH_LOST_DROP) * best_fit
-        if elsewhere and not self._carried and not check_due:
+        lowest = min(value for _, value in self._recent_scores) if self._recent_scores else score
+        self._carried = elsewhere and (fit < (1.0 - SEARCH_LOST_DROP) * best_fit
+                                       or lowest < CARRIED_DROP * self._w_slow)
+        if check_due:
+            lookalike = elsewhere and fit < (1.0 - LOOKALIKE_MARGIN) * best_fit
+            self._check_episode(lookalike, best, best_fit, here, fit, now, score)
+            if self._episode is not None and self._episode.retry_due:
+                self._reset_poses = spread_poses(
+                    ranked[fits >= (1.0 - LOOKALIKE_MARGIN) * best_fit], len(weights),
+                    self.filter.rng, (self.min_noise_xy, self.min_noise_yaw))
+                return
+            if self._recovery_share() < RESET_MIN_SHARE:
+                return
+        if elsewhere and not self._carried:
             # The scores fell, but no place fits the scan clearly better than the cloud's: the
             # best is a look-alike, a little better where the world differs from the map (two
             # pallets moved: 7 %), or a few noisy scans dipped every place's fit. Redrawn there,
@@ -493,13 +519,6 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
                 f"better than the estimate (best ({best[0]:.2f}, {best[1]:.2f}): {best_fit:.2f} "
                 f"against {fit:.2f}): nothing redrawn")
             return
-        if check_due:
-            lookalike = elsewhere and fit < (1.0 - LOOKALIKE_MARGIN) * best_fit
-            self._check_episode(lookalike, best, best_fit, here, fit, now, score)
-            if self._episode is not None and self._episode.retry_due:
-                ranked = ranked[fits >= (1.0 - LOOKALIKE_MARGIN) * best_fit]
-            elif self._recovery_share() < RESET_MIN_SHARE:
-                return
         self._reset_poses = spread_poses(ranked, len(weights), self.filter.rng,
                                          (self.min_noise_xy, self.min_noise_yaw))
 
@@ -632,6 +651,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         super().reset_pose(x, y, yaw, cov_xy, var_yaw)
         self._episode = None
         self._restart_scores()
+        self._recent_scores.clear()
 
     def _spread_globally(self, base: Costmap2D) -> None:
         p = self.params
@@ -645,6 +665,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             self._generation += 1
             self.filter.replace(poses)
         self._restart_scores()
+        self._recent_scores.clear()
         self._episode = None
         self._last_reseed = self.now()
         self.logger.info(f"{self.plugin_name}: global localisation: {count} particles over "
