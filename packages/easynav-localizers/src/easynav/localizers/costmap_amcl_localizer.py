@@ -58,11 +58,14 @@ RESET_MIN_SHARE = 0.1
 SEARCH_RETRY_PERIOD = 2.0
 SEARCH_RETRIES = 5
 SEARCH_LOST_DROP = 0.3
-#: A carried robot's scores fall by half at once (to 0.38-0.43 of their level in the
-#: symmetric hall of the tests, carried onto its cloud's mirror image, where one scan cannot
-#: tell the carry from a changed world; 0.68 for two seconds of scans with 15 cm noise): the
-#: lowest score of the last CARRIED_WINDOW s against the long-term average (the cloud settles
-#: on the best local fit within a second, and the score rises again before the search).
+#: A carried robot's scores fall by half at once: the lowest score of the last CARRIED_WINDOW
+#: s against the long-term average (the mean since the last restart while fewer than
+#: 1/alpha_slow scores came; the cloud settles on the best local fit within a second, and the
+#: score rises again before the search). Measured in the symmetric hall of the tests, carried
+#: onto its cloud's mirror image, where one scan cannot tell the carry from a changed world:
+#: 0.44-0.49; scans with 15 cm range noise 0.68-0.72, 25 cm 0.55-0.58, 30-35 cm (a failing
+#: sensor) 0.41-0.52, which looks like a carry. Likelihood-field model; with hit_count the
+#: carry onto a mirror image is not told apart (its scores fall to 0.55).
 CARRIED_DROP = 0.5
 CARRIED_WINDOW = 2.0
 LOOKALIKE_MARGIN = 0.05
@@ -228,7 +231,6 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._field_map = self._field = None
         self._lf_map = self._lf_field = None
         self._restart_scores()
-        self._recent_scores.clear()
         self._episode = None
         self._reset_poses = None
         with self._lock:
@@ -324,6 +326,8 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         now = self.now()
         self._track_scores(score)
         recent = self._recent_scores
+        if recent and now < recent[-1][0]:
+            recent.clear()  # the clock went back
         recent.append((now, score))
         while recent and (now - recent[0][0] > CARRIED_WINDOW or now < recent[0][0]):
             recent.popleft()
@@ -434,10 +438,13 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._w_fast = self._fast_sum / _seen_share(p.recovery_alpha_fast, n)
 
     def _restart_scores(self) -> None:
-        """Both averages start again from the next score (Nav2's reset after a redraw)."""
+        """Both averages start again from the next score (Nav2's reset after a redraw), and so
+        does the window of recent scores (a lost cloud's score from before a redraw made the
+        next search's verdict "carried")."""
         self._w_slow = self._w_fast = 0.0
         self._slow_sum = self._fast_sum = 0.0
         self._scores_seen = 0
+        self._recent_scores.clear()
 
     def _recovery_share(self) -> float:
         """Augmented MCL's share of the cloud to redraw: ``1 - w_fast/w_slow`` (0 when off),
@@ -651,7 +658,6 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         super().reset_pose(x, y, yaw, cov_xy, var_yaw)
         self._episode = None
         self._restart_scores()
-        self._recent_scores.clear()
 
     def _spread_globally(self, base: Costmap2D) -> None:
         p = self.params
@@ -665,7 +671,6 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             self._generation += 1
             self.filter.replace(poses)
         self._restart_scores()
-        self._recent_scores.clear()
         self._episode = None
         self._last_reseed = self.now()
         self.logger.info(f"{self.plugin_name}: global localisation: {count} particles over "
