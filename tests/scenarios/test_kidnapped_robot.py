@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from scenario_run import SCENARIO_OVERRIDES, ScenarioRun, speed_up
@@ -92,10 +93,18 @@ def test_a_robot_carried_across_the_depot_is_found_and_finishes_its_mission(tmp_
         if max(first, since) <= t <= min(last, ended_at)
     ]
     assert errors.size == len(stamps) and errors.size > 50
-    # The first estimate after the carry only: the recovery takes a second or more (the
-    # short-term score average has to fall first), but under load the estimates recorded can
-    # be 1.4 s apart, and the fifth was once already on the robot (found 2.4 s after the carry).
-    assert float(errors[0]) > 2.0, (stamps[0] - carried_at, errors[:5])
+    # The estimates of the first 0.8 s after the carry: the recovery takes over a second (the
+    # short-term score average has to fall first; found 1.1 s after the carry at the soonest).
+    # Under load the estimates recorded can be seconds apart (4 s beside a CPU hog, the first
+    # one after the carry already on the robot): then the localizer's log shows that it had
+    # to find the robot again (the recovery's redraw), which it would not had the odometry
+    # seen the carry.
+    early = errors[np.asarray(stamps) <= carried_at + 0.8]
+    if early.size:
+        assert float(early.min()) > 2.0, early
+    else:
+        log = (run.run_dir / "easynav.log").read_text(errors="replace")
+        assert "(scores fell: kidnapped?)" in log, (stamps[0] - carried_at, errors[:5])
     # Found: the estimate settles on the robot and stays there to the end. The redraw puts
     # particles at the robot and at the depot's look-alike places (the hall is nearly
     # point-symmetric), and the estimate may sit at one, then the other, for a second or two,
