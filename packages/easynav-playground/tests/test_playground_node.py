@@ -145,6 +145,54 @@ def test_non_finite_cmd_vel_stops_the_base_and_is_counted(ros_bed):
     assert node._rejected_commands == 1
 
 
+class StallingStepper:
+    """Steps ``sim``, stalls once for ``stall`` wall seconds at step ``at`` (the machine was
+    busy elsewhere), and records ``(wall time, simulated time)`` after every step."""
+
+    def __init__(self, sim, at: int, stall: float) -> None:
+        self.sim, self.at, self.stall = sim, at, stall
+        self.samples: list[tuple[float, float]] = []
+        self.stall_ended: float | None = None
+
+    def step(self) -> None:
+        if len(self.samples) == self.at:
+            time.sleep(self.stall)
+            self.stall_ended = time.monotonic()
+        self.sim.step()
+        self.samples.append((time.monotonic(), self.sim.time))
+
+
+def test_a_stalled_simulation_goes_on_from_where_it_stopped_without_jumping_ahead(ros_bed):
+    # A stall of the simulation thread (the machine is loaded) pauses the world; it must not
+    # make up for it by running the lost time in a burst: the stack, slowed by the same load,
+    # would see a person walk half a second in one look.
+    from rclpy.parameter import Parameter
+
+    from easynav.playground.ros.playground_node import MAX_CATCH_UP, PlaygroundNode
+
+    speed_up = 4.0
+    node = ros_bed.add(PlaygroundNode(
+        context=ros_bed.context,
+        parameter_overrides=[Parameter("speed_up", value=speed_up)],
+    ))
+    stepper = StallingStepper(node.sim, at=50, stall=0.2)
+    node._stepper = stepper
+    node.start()
+    try:
+        assert wait_for(lambda: stepper.stall_ended is not None
+                        and stepper.samples[-1][0] > stepper.stall_ended + 0.1)
+    finally:
+        node.stop()
+    stall_end = stepper.stall_ended
+    at_stall = stepper.samples[stepper.at][1] - node.sim.step_size  # before the stalled step
+    after = [(wall, sim) for wall, sim in stepper.samples if wall <= stall_end + 0.05]
+    wall, sim = after[-1]
+    # Steps after a restart keep to the schedule: at most the allowed catch-up beyond it.
+    allowed = MAX_CATCH_UP + (wall - stall_end) * speed_up + 2 * node.sim.step_size
+    assert sim - at_stall <= allowed, (
+        f"the world jumped {sim - at_stall:.3f} s in {wall - stall_end:.3f} s of wall time")
+
+
 def test_command_line_reports_an_unknown_world_and_exits_2():
     result = subprocess.run(
         [sys.executable, "-m", "easynav.playground", "--world", "atlantis"],
