@@ -13,7 +13,11 @@ from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
 from easynav.core.types import Header, Odometry, Pose, Transform, TransformStamped, Twist
-from easynav.localizers.amcl_localizer import AMCLLocalizer
+from easynav.localizers.amcl_localizer import (
+    AMCLLocalizer,
+    moved_by_increment,
+    odometry_increment,
+)
 from easynav.maps import SimpleMap, resolve_map_file
 
 _namespaces = itertools.count()
@@ -220,3 +224,15 @@ def test_scores_in_numpy_at_the_simple_stacks_size_and_compiled_beyond(monkeypat
         sim = Sim(dict(SEED_PARAMS, num_particles=particles))
         sim.step(0.0, 0.0, 0.02, correct=True)
     assert calls == [(200, False), (2000, True)]
+
+
+def test_a_pose_moved_by_the_increment_between_two_odometries_lands_on_the_second():
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        a, b = rng.uniform((-5, -5, -math.pi), (5, 5, math.pi), (2, 3))
+        moved = moved_by_increment(a, odometry_increment(tuple(a), tuple(b)))[0]
+        assert np.allclose(moved[:2], b[:2])
+        assert abs((moved[2] - b[2] + math.pi) % (2 * math.pi) - math.pi) < 1e-9
+    # A robot 1 m along x, facing +y, that drove 1 m forward and turned a quarter: (1, 1, π).
+    assert np.allclose(moved_by_increment(np.array([[1.0, 0.0, math.pi / 2]]),
+                                          (1.0, 0.0, math.pi / 2)), [[1.0, 1.0, math.pi]])

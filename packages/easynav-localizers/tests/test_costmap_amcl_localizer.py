@@ -479,3 +479,42 @@ def test_a_robot_carried_onto_the_mirror_image_of_its_place_is_found(seed):
     errors = sim.drive(15.0, v=0.0)
     assert errors[0] > 10.0
     assert np.mean(errors[-100:]) < 0.1, errors[::50]
+
+
+def test_particles_redrawn_after_a_search_are_carried_by_the_odometry_since_the_scan(monkeypatch):
+    """The search takes tens of milliseconds (seconds on a loaded machine) and the RT loop
+    goes on predicting meanwhile: a robot turning on the spot at 1 rad/s while it searched
+    0.4 s had turned 0.4 rad since its scan. The redrawn particles fit the scan where the
+    robot was; placed there, a turning robot's cloud trailed behind it and was found late
+    (12 s in the depot beside two busy processes). They are carried by the odometry since."""
+    import easynav.localizers.costmap_amcl_localizer as module
+
+    real = module.scan_match
+    turned = []
+
+    def slow_search(costmap, points, *args, **kwargs):
+        result = real(costmap, points, *args, **kwargs)
+        for _ in range(20):  # meanwhile, the RT loop: 0.4 s turning at 1 rad/s
+            sim.step(0.0, 1.0, 0.02, correct=False)
+        turned.append(True)
+        return result
+
+    params = dict(BASE, sensor_model="likelihood_field", num_particles=500,
+                  recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
+                  **{"initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
+    sim = Sim(params, seed=5)
+    sim.drive(4.0)
+    assert sim.error() < 0.1
+    monkeypatch.setattr(module, "scan_match", slow_search)
+    sim.true[:] = (0.0, 5.8, 0.0)  # the north corridor, without odometry of the move
+    for _ in range(200):  # still, scanning, until the first redraw
+        sim.step(0.0, 0.0, 0.02, correct=True)
+        if turned:
+            break
+    assert turned and sim.amcl._episode is not None
+    poses = sim.amcl.filter.poses
+    near = np.hypot(poses[:, 0] - sim.true[0], poses[:, 1] - sim.true[1]) < 0.3
+    yaw_error = np.abs((poses[near, 2] - sim.true[2] + math.pi) % (2 * math.pi) - math.pi)
+    assert near.sum() > 20
+    # On the robot as it is now (0.4 rad on from its scan), within the redraw's spread.
+    assert np.median(yaw_error) < 0.1, np.median(yaw_error)

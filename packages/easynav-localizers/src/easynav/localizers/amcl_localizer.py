@@ -74,6 +74,17 @@ def odometry_increment(
     return c * dx + s * dy, -s * dx + c * dy, normalize_angle(b[2] - a[2])
 
 
+def moved_by_increment(poses: np.ndarray, increment: tuple[float, float, float]) -> np.ndarray:
+    """The planar ``poses`` ``(N, 3)`` each moved by the odometry ``increment`` ``(dx, dy,
+    dyaw)`` taken in its own frame (:func:`odometry_increment`): where a pose estimated at one
+    odometry is at a later one."""
+    poses = np.asarray(poses, dtype=float).reshape(-1, 3)
+    dx, dy, dyaw = increment
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    return np.column_stack((poses[:, 0] + c * dx - s * dy, poses[:, 1] + s * dx + c * dy,
+                            np.arctan2(np.sin(poses[:, 2] + dyaw), np.cos(poses[:, 2] + dyaw))))
+
+
 def _xy_yaw(pose: Pose) -> tuple[float, float, float]:
     return pose.x, pose.y, pose.yaw
 

@@ -14,7 +14,12 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import ROBOT_POSE, NavStateKey
 from easynav.core.plugins import Param, PluginConfigurationError, Topic
 from easynav.core.types import Costmap2D, Header, Odometry, Pose
-from easynav.localizers.amcl_localizer import MIN_POINT_Z, AMCLLocalizer
+from easynav.localizers.amcl_localizer import (
+    MIN_POINT_Z,
+    AMCLLocalizer,
+    moved_by_increment,
+    odometry_increment,
+)
 from easynav.localizers.costmap_sampling import (
     RESET_FINE_SIGMA,
     RESET_STRIDE,
@@ -213,6 +218,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         self._reset_map: Costmap2D | None = None
         self._reset_fields: tuple[np.ndarray, np.ndarray] | None = None
         self._reset_poses: np.ndarray | None = None  # ranked, best first; None: uniform redraws
+        self._reset_odom: tuple[float, float, float] | None = None  # odometry of their scan
         self._redrawn = False  # _inject_random redrew in this update: no reseed after it
 
     # -- configuration ------------------------------------------------------------------------
@@ -319,6 +325,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         with self._lock:
             snapshot = self.filter.poses.copy()
             generation = self._generation
+            odom_at_scan = self._odom_used
         if self.params.sensor_model == LIKELIHOOD_FIELD:
             weights, score = self._likelihood_field_weights(snapshot, points, base)
         else:
@@ -332,7 +339,7 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         while recent and (now - recent[0][0] > CARRIED_WINDOW or now < recent[0][0]):
             recent.popleft()
         reseed_due = now - self._last_reseed >= self.reseed_period or now < self._last_reseed
-        self._prepare_sensor_reset(base, points, weights, reseed_due, now, score)
+        self._prepare_sensor_reset(base, points, weights, reseed_due, now, score, odom_at_scan)
         self._redrawn = False
         with self._lock:
             if generation == self._generation:  # not redrawn (initialpose) while scoring
@@ -457,15 +464,18 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
 
     def _prepare_sensor_reset(self, base: Costmap2D, points: np.ndarray,
                               weights: np.ndarray, reseed_due: bool, now: float,
-                              score: float) -> None:
+                              score: float, odom_at_scan: tuple[float, float, float] | None
+                              ) -> None:
         """When this update will redraw particles (a reseed, or a likelihood-field resample)
         and the scores fell, or a kidnap episode's check is due (:meth:`_check_episode`), rank
         the poses where this scan fits the map, for :meth:`_inject_random`, and compare the
         best with the cloud's estimate. Outside the lock: the search takes tens of
         milliseconds and the compiled scoring releases the GIL, so the RT loop runs
-        meanwhile. Computed for this update's scan only: a ranking kept for a later update
-        would place the particles where the robot was."""
+        meanwhile. The ranking is where the robot was at ``odom_at_scan`` (the odometry the
+        scored cloud had reached); the redraw carries it on by the odometry since. Computed
+        for this update's scan only."""
         self._reset_poses = None
+        self._reset_odom = odom_at_scan
         if not self.params.recovery_sensor_resetting:
             return
         episode = self._episode
@@ -488,8 +498,13 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
             self._reset_fields = (likelihood_field(base, RESET_STRIDE),
                                   likelihood_field(base, RESET_FINE_SIGMA))
             self._reset_map = base
-        with self._lock:  # before the search: after it, the RT loop has moved it on ~0.15 s
-            estimate = self.filter.estimate()
+        with self._lock:
+            estimate = np.array(self.filter.estimate())
+            odom_now = self._odom_used
+        if odom_at_scan is not None and odom_now is not None:
+            # Where the cloud was when the scan was taken: the RT loop has carried it on by
+            # the odometry since (a robot turning at 1 rad/s turned 0.3 rad in a loaded 0.3 s).
+            estimate = moved_by_increment(estimate, odometry_increment(odom_now, odom_at_scan))[0]
         try:
             ranked, fits = scan_match(base, points, *self._reset_fields)
         except ValueError:
@@ -626,6 +641,10 @@ class CostmapAMCLLocalizer(AMCLLocalizer):
         order = shuffled[np.argsort(self.filter.weights[shuffled], kind="stable")][:count]
         if ranked is not None:
             poses, where = np.resize(ranked, (count, 3)), "where the scan fits the map"
+            if self._reset_odom is not None and self._odom_used is not None:
+                # The places fit the scan where the robot was; it has driven on since.
+                poses = moved_by_increment(
+                    poses, odometry_increment(self._reset_odom, self._odom_used))
         else:
             try:
                 poses = sample_free_space(base, count, self.filter.rng)

@@ -15,7 +15,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import NavStateKey
 from easynav.core.plugins import Param, PluginConfigurationError
 from easynav.core.types import Costmap2D, normalize_angle
-from easynav.localizers.amcl_localizer import odometry_increment
+from easynav.localizers.amcl_localizer import moved_by_increment, odometry_increment
 from easynav.localizers.costmap_amcl_localizer import (
     LIKELIHOOD_FIELD,
     CostmapAMCLLocalizer,
@@ -478,13 +478,9 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
         """The candidates carried by the odometry received since the scan (lock held)."""
         if odom_at_scan is None or self._odom_used is None or not candidates:
             return candidates
-        dx, dy, dyaw = odometry_increment(odom_at_scan, self._odom_used)
-        moved = []
-        for pose, quality in candidates:
-            c, s = math.cos(pose[2]), math.sin(pose[2])
-            moved.append((np.array((pose[0] + c * dx - s * dy, pose[1] + s * dx + c * dy,
-                                    normalize_angle(pose[2] + dyaw))), quality))
-        return moved
+        poses = moved_by_increment(np.array([pose for pose, _ in candidates]),
+                                   odometry_increment(odom_at_scan, self._odom_used))
+        return [(pose, quality) for pose, (_, quality) in zip(poses, candidates, strict=True)]
 
     def _restart_from(self, candidates) -> None:
         """Global localisation: one hypothesis per cluster, all even (lock held)."""
