@@ -518,3 +518,88 @@ def test_particles_redrawn_after_a_search_are_carried_by_the_odometry_since_the_
     assert near.sum() > 20
     # On the robot as it is now (0.4 rad on from its scan), within the redraw's spread.
     assert np.median(yaw_error) < 0.1, np.median(yaw_error)
+
+
+def test_an_initial_pose_away_from_the_searchs_best_place_is_kept(monkeypatch):
+    """The operator knows better than the search: during a kidnap episode whose searches all
+    prefer the mirror image of the robot's place (forced here: the mirror, said to fit 10 %
+    better than anything), an initialpose on the robot's place ends the episode, and no later
+    check redraws the cloud toward the search's place (kept, the episode redrew half the cloud
+    there 5 times)."""
+    import easynav.localizers.costmap_amcl_localizer as module
+
+    real = module.scan_match
+    truth = (3.0, 3.5, math.pi)
+    mirror = (16.0 - truth[0], 8.0 - truth[1], 0.0)
+    calls = []
+
+    def mirror_only(costmap, points, *args, **kwargs):
+        ranked, fits = real(costmap, points, *args, **kwargs)
+        calls.append(sim.t)
+        # The mirror, said to fit 10 % better than the best place found.
+        return np.tile(mirror, (len(ranked), 1)), np.full(len(fits), 1.1 * fits[0])
+
+    params = dict(BASE, sensor_model="likelihood_field", num_particles=500,
+                  recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
+                  **{"initial_pose.x": 2.0, "initial_pose.y": 2.0,
+                     "initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
+    sim = Sim(params, start=(2.0, 2.0, 0.0), seed=8, costmap=point_symmetric_hall(),
+              laser_range=12.0)
+    monkeypatch.setattr(module, "scan_match", mirror_only)
+    sim.drive(3.0, v=0.2)
+    sim.true[:] = truth  # carried, without odometry of the move
+    for _ in range(100):  # until the first redraw (at the mirror) starts an episode
+        sim.drive(0.2, v=0.0)
+        if sim.amcl._episode is not None:
+            break
+    assert sim.amcl._episode is not None
+    sim.amcl.on_last_known_pose(Odometry(Header(sim.t, "map"), "base_footprint",
+                                         Pose.from_xy_yaw(*sim.true)))
+    searched_before = len(calls)
+    errors = sim.drive(12.0, v=0.0)  # turning on the spot
+    assert max(errors) < 0.2, max(errors)
+    # No search, no redraw toward the mirror: the scores at the given pose did not fall.
+    assert sim.amcl._episode is None and len(calls) == searched_before
+
+
+@pytest.mark.parametrize("seed", [5, 6])
+def test_a_redraw_in_a_resample_update_keeps_the_rest_of_the_cloud(seed):
+    """A redraw replaces its share of the cloud, no more. When it came in the resample of an
+    update whose reseed was due too, the reseed redrew the "worse half" around the better
+    one, but after a resample every weight is equal, and the "better half" was the redrawn
+    one copied over the rest (twice the share went to the search's places: 0.67 for 0.34), and
+    a search that missed had less left where the robot might be. The reseed is skipped then."""
+    params = dict(BASE, sensor_model="likelihood_field", num_particles=500, reseed_freq=2.0,
+                  recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
+                  **{"initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
+    sim = Sim(params, seed=seed)
+    sim.drive(4.0)
+    assert sim.error() < 0.1
+    before = np.array(sim.amcl.filter.estimate())
+    sim.true[:] = (0.0, 5.8, 0.0)  # the north corridor, without odometry of the move
+    redraws, reseeds = [], []  # the share redrawn; the redraws before each reseed
+    inject, reseed = sim.amcl._inject_random, sim.amcl._reseed
+
+    def recording_inject(base):
+        share = sim.amcl._recovery_share()
+        redrawn = inject(base)
+        if redrawn:
+            redraws.append(share)
+        return redrawn
+
+    def recording_reseed(base):
+        reseeds.append(len(redraws))
+        reseed(base)
+
+    sim.amcl._inject_random, sim.amcl._reseed = recording_inject, recording_reseed
+    for _ in range(200):  # still, scanning, until the first redraw
+        reseeds.clear()
+        sim.step(0.0, 0.0, 0.02, correct=True)
+        if redraws:
+            break
+    # The redraw came in the resample (before the reseed), and the reseed was due.
+    assert redraws and reseeds == [1], (redraws, reseeds)
+    poses = sim.amcl.filter.poses
+    kept = np.hypot(poses[:, 0] - before[0], poses[:, 1] - before[1]) < 1.0
+    # Everything not redrawn is where the cloud was (the redraw's places are elsewhere).
+    assert abs((1.0 - kept.mean()) - redraws[0]) < 0.05, (1.0 - kept.mean(), redraws[0])
