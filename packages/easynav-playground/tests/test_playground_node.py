@@ -162,20 +162,28 @@ class StallingStepper:
         self.samples.append((time.monotonic(), self.sim.time))
 
 
-def test_a_stalled_simulation_goes_on_from_where_it_stopped_without_jumping_ahead(ros_bed):
+#: What the playground's README promises: a late simulation catches up at most this much.
+CATCH_UP = 0.02  # s, simulated
+
+
+@pytest.mark.parametrize("stall", [0.015, 0.2])
+def test_a_stalled_simulation_goes_on_from_where_it_stopped_without_jumping_ahead(
+    ros_bed, stall
+):
     # A stall of the simulation thread (the machine is loaded) pauses the world; it must not
     # make up for it by running the lost time in a burst: the stack, slowed by the same load,
-    # would see a person walk half a second in one look.
+    # would see a person walk half a second in one look. (A short stall, 60 ms simulated at
+    # x4, and one longer than any catch-up: both end in a restart of the schedule.)
     from rclpy.parameter import Parameter
 
-    from easynav.playground.ros.playground_node import MAX_CATCH_UP, PlaygroundNode
+    from easynav.playground.ros.playground_node import PlaygroundNode
 
     speed_up = 4.0
     node = ros_bed.add(PlaygroundNode(
         context=ros_bed.context,
         parameter_overrides=[Parameter("speed_up", value=speed_up)],
     ))
-    stepper = StallingStepper(node.sim, at=50, stall=0.2)
+    stepper = StallingStepper(node.sim, at=50, stall=stall)
     node._stepper = stepper
     node.start()
     try:
@@ -187,10 +195,12 @@ def test_a_stalled_simulation_goes_on_from_where_it_stopped_without_jumping_ahea
     at_stall = stepper.samples[stepper.at][1] - node.sim.step_size  # before the stalled step
     after = [(wall, sim) for wall, sim in stepper.samples if wall <= stall_end + 0.05]
     wall, sim = after[-1]
-    # Steps after a restart keep to the schedule: at most the allowed catch-up beyond it.
-    allowed = MAX_CATCH_UP + (wall - stall_end) * speed_up + 2 * node.sim.step_size
+    # Steps after a restart keep to the schedule: at most the catch-up beyond it (a load that
+    # slows the steps only lowers the jump).
+    allowed = CATCH_UP + (wall - stall_end) * speed_up + 2 * node.sim.step_size
     assert sim - at_stall <= allowed, (
         f"the world jumped {sim - at_stall:.3f} s in {wall - stall_end:.3f} s of wall time")
+    assert node.schedule_restarts >= 1
 
 
 def test_command_line_reports_an_unknown_world_and_exits_2():

@@ -122,7 +122,8 @@ def main(argv: list[str] | None = None) -> int:
             if time.monotonic() - last_report > 30.0:
                 last_report = time.monotonic()
                 node.get_logger().info(
-                    f"t={node.sim.time:.1f} s simulated, x{node.real_time_factor:.2f} real time, "
+                    f"t={node.sim.time:.1f} s simulated, x{node.real_time_factor:.2f} real time "
+                    f"({node.schedule_restarts} schedule restart(s)), "
                     f"{node.collision_count} collision(s)"
                 )
     except (ValueError, FileNotFoundError, KeyError) as err:

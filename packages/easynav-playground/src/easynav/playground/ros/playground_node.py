@@ -392,6 +392,7 @@ class PlaygroundNode(Node):
                 "sim_time": self.sim.time,
             }
         data["wall_time"] = self._loop.elapsed()
+        data["schedule_restarts"] = self.schedule_restarts
         data["world"] = self.description.world.name
         tmp = Path(path).with_name(Path(path).name + ".tmp")
         tmp.write_text(json.dumps(data))
@@ -401,6 +402,12 @@ class PlaygroundNode(Node):
     def collision_count(self) -> int:
         """Collisions of every robot so far."""
         return sum(len(port.sim.checker.collisions) for port in self.ports)
+
+    @property
+    def schedule_restarts(self) -> int:
+        """Times the simulation fell more than :data:`MAX_CATCH_UP` behind its schedule and
+        went on from where it was (the machine could not keep up)."""
+        return self._loop.restarts
 
     @property
     def real_time_factor(self) -> float:
