@@ -233,6 +233,7 @@ def test_a_pose_moved_by_the_increment_between_two_odometries_lands_on_the_secon
         moved = moved_by_increment(a, odometry_increment(tuple(a), tuple(b)))[0]
         assert np.allclose(moved[:2], b[:2])
         assert abs((moved[2] - b[2] + math.pi) % (2 * math.pi) - math.pi) < 1e-9
-    # A robot 1 m along x, facing +y, that drove 1 m forward and turned a quarter: (1, 1, π).
+    # A robot 1 m along x, facing +y, that drove 1 m forward and turned a quarter: (1, 1, -π)
+    # (headings in [-π, π), as normalize_angle's).
     assert np.allclose(moved_by_increment(np.array([[1.0, 0.0, math.pi / 2]]),
-                                          (1.0, 0.0, math.pi / 2)), [[1.0, 1.0, math.pi]])
+                                          (1.0, 0.0, math.pi / 2)), [[1.0, 1.0, -math.pi]])

@@ -603,3 +603,38 @@ def test_a_redraw_in_a_resample_update_keeps_the_rest_of_the_cloud(seed):
     kept = np.hypot(poses[:, 0] - before[0], poses[:, 1] - before[1]) < 1.0
     # Everything not redrawn is where the cloud was (the redraw's places are elsewhere).
     assert abs((1.0 - kept.mean()) - redraws[0]) < 0.05, (1.0 - kept.mean(), redraws[0])
+
+
+def test_a_robot_turning_through_a_slow_update_is_not_taken_for_a_look_alike():
+    """The search compares its best place, where the scan was taken, with the cloud's estimate
+    as it was then. Compared with the estimate as the RT loop had moved it on while the scan
+    was weighed (0.4 s on a loaded machine, at 1.5 rad/s: 0.6 rad), the found robot was
+    "elsewhere" from the search's best: every check of the kidnap episode took it for one on
+    a look-alike and redrew half its cloud again."""
+    params = dict(BASE, sensor_model="likelihood_field", num_particles=500,
+                  recovery_alpha_slow=0.001, recovery_alpha_fast=0.1,
+                  **{"initial_pose.std_dev_xy": 0.1, "initial_pose.std_dev_yaw": 0.05})
+    sim = Sim(params, seed=5)
+    sim.drive(4.0)
+    weigh, check = sim.amcl._likelihood_field_weights, sim.amcl._check_episode
+    checks = []
+
+    def slow_weighing(*args):
+        result = weigh(*args)
+        for _ in range(20):  # meanwhile, the RT loop: 0.4 s turning at 1.5 rad/s
+            sim.step(0.0, 1.5, 0.02, correct=False)
+        return result
+
+    def recording_check(lookalike, *args):
+        checks.append(lookalike)
+        check(lookalike, *args)
+
+    sim.amcl._likelihood_field_weights = slow_weighing
+    sim.amcl._check_episode = recording_check
+    sim.true[:] = (0.0, 5.8, 0.0)  # the north corridor, without odometry of the move
+    errors = []
+    for i in range(300):  # turning on the spot, scanning every 0.2 s (and 0.4 s weighing)
+        sim.step(0.0, 1.5, 0.02, correct=(i % 10 == 0))
+        errors.append(sim.error())
+    assert np.mean(errors[-100:]) < 0.1, errors[::50]
+    assert checks and not any(checks), checks

@@ -81,8 +81,8 @@ def moved_by_increment(poses: np.ndarray, increment: tuple[float, float, float])
     poses = np.asarray(poses, dtype=float).reshape(-1, 3)
     dx, dy, dyaw = increment
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-    return np.column_stack((poses[:, 0] + c * dx - s * dy, poses[:, 1] + s * dx + c * dy,
-                            np.arctan2(np.sin(poses[:, 2] + dyaw), np.cos(poses[:, 2] + dyaw))))
+    yaw = (poses[:, 2] + dyaw + math.pi) % (2.0 * math.pi) - math.pi  # [-π, π), as normalize_angle
+    return np.column_stack((poses[:, 0] + c * dx - s * dy, poses[:, 1] + s * dx + c * dy, yaw))
 
 
 def _xy_yaw(pose: Pose) -> tuple[float, float, float]:
