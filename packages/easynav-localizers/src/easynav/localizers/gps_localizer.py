@@ -235,8 +235,10 @@ class GpsLocalizer(LocalizerMethodBase):
             roll, pitch, yaw, stamp = e.roll, e.pitch, e.yaw, e.stamp
             covariance = e.covariance6()
             angular_velocity = e.angular_velocity.copy()
-            self._send_map_to_odom(*fix)
-            carried = self._carried(fix[6])
+            # One look at odometry for both: the anchor sent and the pose carried agree.
+            latest = self._latest_odometry()
+            self._send_map_to_odom(*fix, latest)
+            carried = self._carried(fix[6], latest)
         x, y = fix[0], fix[1]
         if carried is not None:
             x, y, stamp, driven = carried
@@ -257,22 +259,32 @@ class GpsLocalizer(LocalizerMethodBase):
 
             publisher.publish(odometry_to_msg(odometry))
 
-    def _carried(self, taken: int) -> tuple[float, float, float, float] | None:
-        """The robot's position in the map at the newest ``odom → robot``: ``map → odom`` as
-        anchored on fix number ``taken`` (:meth:`_send_map_to_odom`, or a handover since)
-        composed with it; that odometry's stamp; the way (m) odometry measured since the
-        anchor, summed update by update (a drive there and back drifts as much as one on).
-        None when the anchor is not that fix's, or without odometry. Under the lock."""
-        anchor, driven = self._anchor, self._driven
-        if anchor is None or anchor[0] != taken or driven is None or driven[0] != taken:
-            return None
+    def _latest_odometry(self) -> tuple[float, tuple[float, ...]] | None:
+        """The newest ``odom → robot`` (stamp, (x, y, z, qx, qy, qz, qw)); None, with a
+        throttled warning, while TF has none."""
         buffer = get_tf_buffer(self.context.namespace)
         tf_info = buffer.get_tf_info()
         try:
-            newest, (ox, oy, _, *q) = buffer.lookup_transform_values(
-                tf_info.odom_frame, tf_info.robot_footprint_frame)
-        except LookupError:
+            return buffer.lookup_transform_values(tf_info.odom_frame,
+                                                  tf_info.robot_footprint_frame)
+        except LookupError as exc:  # no odometry transform (yet): nothing to anchor it on
+            self._throttle.warn(self.logger, "no-odom-tf",
+                                f"{self.plugin_name}: no map → odom: {exc}")
             return None
+
+    def _carried(self, taken: int, latest: tuple[float, tuple[float, ...]] | None
+                 ) -> tuple[float, float, float, float] | None:
+        """The robot's position in the map at ``latest``, the newest ``odom → robot``
+        (:meth:`_latest_odometry`): ``map → odom`` as anchored on fix number ``taken``
+        (:meth:`_send_map_to_odom`, or a handover since) composed with it; that odometry's
+        stamp; the way (m) odometry measured since the anchor, summed update by update (a
+        drive there and back drifts as much as one on). None when the anchor is not that
+        fix's, or without odometry. Under the lock."""
+        anchor, driven = self._anchor, self._driven
+        if (latest is None or anchor is None or anchor[0] != taken or driven is None
+                or driven[0] != taken):
+            return None
+        newest, (ox, oy, _, *q) = latest
         x, y, _ = _compose(anchor[1:], (ox, oy, quaternion_to_yaw(*q)))
         way = driven[3] + math.hypot(ox - driven[1], oy - driven[2])
         self._driven = (taken, ox, oy, way)
@@ -306,7 +318,8 @@ class GpsLocalizer(LocalizerMethodBase):
         return ox, oy, quaternion_to_yaw(*q)
 
     def _send_map_to_odom(self, x: float, y: float, fix_stamp: float, yaw: float,
-                          yaw_stamp: float | None, yaw_rate: float, taken: int) -> None:
+                          yaw_stamp: float | None, yaw_rate: float, taken: int,
+                          latest: tuple[float, tuple[float, ...]] | None) -> None:
         """``map → odom`` that puts the robot at the estimate, anchored once per fix taken:
         the fix's position with ``odom → robot`` at its stamp, the rotation from the IMU
         filter's yaw with odometry's yaw at one instant (the yaw moved back by the gyro to the
@@ -321,15 +334,11 @@ class GpsLocalizer(LocalizerMethodBase):
         ``robot_pose``, and what the maps managers fuse into the map frame from the robot's
         sensors landed there (on the campus, walls drawn across the way to a waypoint: no
         path)."""
+        if latest is None:  # no odometry transform (yet): nothing to anchor it on
+            return
         buffer = get_tf_buffer(self.context.namespace)
         tf_info = buffer.get_tf_info()
-        try:
-            newest, _ = buffer.lookup_transform_values(tf_info.odom_frame,
-                                                       tf_info.robot_footprint_frame)
-        except LookupError as exc:  # no odometry transform (yet): nothing to anchor it on
-            self._throttle.warn(self.logger, "no-odom-tf",
-                                f"{self.plugin_name}: no map → odom: {exc}")
-            return
+        newest = latest[0]
         if newest < self._sent_stamp - CLOCK_JUMP:  # the clock went back: start again
             self._sent_stamp, self._anchor, self._driven = -math.inf, None, None
         ahead = fix_stamp - newest
