@@ -239,6 +239,28 @@ def test_the_controller_cycle_is_read_from_easynavs_log(tmp_path):
         summary.format_table())
 
 
+def test_the_odometry_transforms_age_is_read_from_easynavs_log(tmp_path):
+    from easynav.playground.demo.demo_run import odometry_age_from_log
+
+    log = tmp_path / "easynav.log"
+    assert odometry_age_from_log(log) is None  # no log
+    log.write_text("[INFO] [1.0] [system_node]: EasyNav is active\n")
+    assert odometry_age_from_log(log) is None  # no line
+    log.write_text(
+        "[INFO] [9.0] [system_node]: age of odom → base_footprint when served: 400 "
+        "transforms, median 1.5 ms, p99 20.0 ms, max 80.0 ms\n"
+        "[INFO] [19.0] [system_node]: age of odom → base_footprint when served: 900 "
+        "transforms, median -2.5 ms, p99 31.5 ms, max 1300.2 ms\n"
+    )
+    age = odometry_age_from_log(log)
+    assert age == {"transforms": 900, "median_ms": -2.5, "p99_ms": 31.5, "max_ms": 1300.2}
+    summary = RunSummary.compute([], make_truth(), "NAVIGATION_FINISHED", "", 0.0, 10.0, 20.0)
+    summary.odometry_age = age
+    assert summary.to_dict()["odometry_age"] == age
+    assert "odom TF age served:   median -2.5 ms, p99 31.5 ms, max 1300.2 ms (900 " in (
+        summary.format_table())
+
+
 def test_the_gps_localizers_estimate_is_read_from_its_topic(tmp_path):
     """The demo scores the pose the GpsLocalizer publishes on robot/odom_gps (the original's
     map -> odom was a static identity); every other localizer is read from TF."""

@@ -280,6 +280,9 @@ class SystemNode(LifecycleNode):
             node = self.subnodes[name]
             if node.lifecycle_state() == "active":
                 node.trigger_deactivate()
+        line = self.tf_listener.describe_odometry_age()
+        if line is not None:
+            self.get_logger().info(line)
         return super().on_deactivate(state)
 
     def _stop_cycles(self) -> None:

@@ -323,6 +323,7 @@ class DemoRun:
         if monitor is not None:
             summary.late_rt_cycles = monitor.late_cycles
         summary.controller_cycle = controller_cycle_from_log(self.record.with_name("easynav.log"))
+        summary.odometry_age = odometry_age_from_log(self.record.with_name("easynav.log"))
         truth.save(self.record.with_name("run.json"))  # truth + EasyNav's estimates
         if monitor is not None:
             self.record.with_name("paths.json").write_text(json.dumps(monitor.paths_record()))
@@ -388,4 +389,23 @@ def controller_cycle_from_log(log_path: Path) -> dict | None:
                 "median_ms": float(match["median"]), "p99_ms": float(match["p99"]),
                 "max_ms": float(match["max"]),
             }
+    return found
+
+
+def odometry_age_from_log(log_path: Path) -> dict | None:
+    """How old the ``odom → robot`` transforms were when EasyNav's TF listener served them, from
+    the line system_node logs when it is deactivated (the last one): ``{"transforms",
+    "median_ms", "p99_ms", "max_ms"}``; None when absent."""
+    from easynav.system.tf.tf_listener import ODOMETRY_AGE_PATTERN
+
+    try:
+        text = log_path.read_text(errors="replace")
+    except OSError:
+        return None
+    found = None
+    for match in ODOMETRY_AGE_PATTERN.finditer(text):
+        found = {
+            "transforms": int(match["count"]), "median_ms": float(match["median"]),
+            "p99_ms": float(match["p99"]), "max_ms": float(match["max"]),
+        }
     return found

@@ -38,6 +38,11 @@ class RunSummary:
     #: The controller's update_rt cost as EasyNav logged it when it stopped: ``{"alias",
     #: "plugin", "runs", "median_ms", "p99_ms", "max_ms"}``; None when not found.
     controller_cycle: dict | None = None
+    #: How old the ``odom → robot`` transforms were when EasyNav's TF listener served them
+    #: (its executor's backlog, which every pose lookup lags by): ``{"transforms",
+    #: "median_ms", "p99_ms", "max_ms"}`` as EasyNav logged it when it stopped; None when not
+    #: found.
+    odometry_age: dict | None = None
     #: The steepest ground (rad) under the robot during the navigation; NaN on flat worlds.
     max_slope: float = math.nan
 
@@ -121,6 +126,7 @@ class RunSummary:
             "real_time_factor": clean(self.real_time_factor),
             "late_rt_cycles": self.late_rt_cycles,
             "controller_cycle": self.controller_cycle,
+            "odometry_age": self.odometry_age,
             "max_slope_deg": clean(math.degrees(self.max_slope)),
             "success": self.success,
         }
@@ -173,6 +179,12 @@ class RunSummary:
             lines.append(
                 f"controller cycle:     median {c['median_ms']:.2f} ms, p99 {c['p99_ms']:.2f} ms, "
                 f"max {c['max_ms']:.2f} ms ({c['alias']}: {c['plugin']}, {c['runs']} runs)"
+            )
+        if self.odometry_age is not None:
+            a = self.odometry_age
+            lines.append(
+                f"odom TF age served:   median {a['median_ms']:.1f} ms, p99 {a['p99_ms']:.1f} ms, "
+                f"max {a['max_ms']:.1f} ms ({a['transforms']} transforms)"
             )
         for c in self.collisions:
             lines.append(

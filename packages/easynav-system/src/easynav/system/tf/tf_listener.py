@@ -2,11 +2,20 @@
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from easynav.common.tf.tf_buffer import TFBuffer
 from easynav.common.tf.tf_buffer_registry import get_tf_buffer
+from easynav.system.cycle_times import CycleTimes
 from easynav.system.tf.ros_conversion import stamp_to_seconds
+
+#: The line :meth:`TFListener.describe_odometry_age` writes; tools that read EasyNav's log (the
+#: playground demo's summary) parse it with this.
+ODOMETRY_AGE_PATTERN = re.compile(
+    r"age of (?P<parent>\S+) → (?P<child>\S+) when served: (?P<count>\d+) transforms, "
+    r"median (?P<median>-?[\d.]+) ms, p99 (?P<p99>-?[\d.]+) ms, max (?P<max>-?[\d.]+) ms"
+)
 
 
 class TFListener:
@@ -41,6 +50,7 @@ class TFListener:
 
         self.buffer = buffer if buffer is not None else get_tf_buffer(node.get_namespace())
         self._node = node
+        self.odometry_age = CycleTimes()
         dynamic_qos = QoSProfile(
             depth=100,
             reliability=ReliabilityPolicy.RELIABLE,
@@ -86,6 +96,26 @@ class TFListener:
 
     def _on_tf(self, msg: Any) -> None:
         self._store(msg, "tf", False)
+        robot = self.buffer.get_tf_info().robot_footprint_frame
+        for ts in msg.transforms:
+            if ts.child_frame_id == robot:
+                now = self._node.get_clock().now().nanoseconds * 1e-9
+                self.odometry_age.record(now - stamp_to_seconds(ts.header.stamp))
+                break
+
+    def describe_odometry_age(self) -> str | None:
+        """One log line (matching :data:`ODOMETRY_AGE_PATTERN`) on ``odometry_age``; None
+        before the first ``odom → robot`` transform."""
+        stats = self.odometry_age.summary()
+        if stats is None:
+            return None
+        median, p99, worst = (1e3 * v for v in stats)
+        info = self.buffer.get_tf_info()
+        return (
+            f"age of {info.odom_frame} → {info.robot_footprint_frame} when served: "
+            f"{self.odometry_age.count} transforms, median {median:.1f} ms, p99 {p99:.1f} ms, "
+            f"max {worst:.1f} ms"
+        )
 
     def _on_tf_static(self, msg: Any) -> None:
         self._store(msg, "tf_static", True)
