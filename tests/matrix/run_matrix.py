@@ -4,6 +4,10 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
        [--speed-up 1.0] [--jobs 1] [--results FILE] [--output docs/matrix.md] [--list] [--report]
 
   --slice    only the combinations that together use every plugin once (what CI runs)
+  --speed-up the simulation's speed (x real time; EasyNav's loops keep their wall-clock rates,
+             so its RT cycles per simulated second drop by as much). On a 2-core machine one
+             mission at x2 ran at x1.9-2.0 with the same verdict and figures as at x1 (the
+             campus with MPPI and with VFF): the matrix there runs at x2, one at a time
   --jobs N   N missions at once, each in a process of its own (a mission takes about a core
              at x1: N above the number of cores slows every run and can fail them)
   --results  where each finished run is kept, one JSON line per run (default
@@ -274,10 +278,13 @@ def main(argv: list[str]) -> int:
         for c in combos if c.name in kept
     ]
     commits: dict[str, int] = {}
+    speeds: dict[float, int] = {}
     for c in combos:
         if c.name in kept:
             key = kept[c.name].get("commit", "not recorded")
             commits[key] = commits.get(key, 0) + 1
+            speed = float(kept[c.name].get("speed_up", 1.0))
+            speeds[speed] = speeds.get(speed, 0) + 1
     header = "\n".join([
         "# Integration matrix",
         "",
@@ -289,7 +296,12 @@ def main(argv: list[str]) -> int:
         "--world NAME`: the tb3_sandbox's costmap files, the depot's costmap with its keepout "
         "and speed zones, the campus's files for the Simple* plugins), else as in the "
         "playground's file or the first file under params/ that uses it. A failed row says what "
-        "a user would notice first and, once looked into, why (tests/matrix/findings.yaml).",
+        "a user would notice first and, once looked into, why (tests/matrix/findings.yaml). "
+        "A row run faster than real time (`--speed-up 2`) drives the same mission in simulated "
+        "time, but EasyNav's loops keep their wall-clock rates: its RT cycles per simulated "
+        "second are halved (a controller or smoother set faster than that runs slower), and "
+        "every computation takes twice as long in simulated time. A row that fails so is run "
+        "again at x1 before it is looked into.",
         "",
         f"- date: {started:%Y-%m-%d %H:%M} UTC (rows of earlier parts come from {results_path.name}"
         f"); Python {platform.python_version()}; speed-up x{args.speed_up:g}; "
@@ -300,6 +312,8 @@ def main(argv: list[str]) -> int:
         + f", worlds {args.worlds}: {len(outcomes)} of {len(combos)} runs done",
         "- code of the rows: "
         + (", ".join(f"{key} ({n} rows)" for key, n in sorted(commits.items())) or "none yet"),
+        "- speed-up of the rows: "
+        + (", ".join(f"x{key:g} ({n} rows)" for key, n in sorted(speeds.items())) or "none yet"),
     ])
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     Path(args.output).write_text(markdown(outcomes, header, unmatched, findings))
