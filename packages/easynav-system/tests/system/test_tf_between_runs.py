@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from rclpy.parameter import Parameter
 
 from easynav.common.tf import get_tf_buffer
 from easynav.core.types import Header, Transform, TransformStamped
@@ -39,3 +40,57 @@ def test_a_new_system_does_not_see_the_transforms_of_the_one_before(
     # window" and a lookup gave the first run's pose).
     assert buffer.set_transform(_odom_to_base(1.0, 0.5), "second run")
     assert buffer.lookup_transform("odom", "base_footprint").transform.translation[0] == 0.5
+
+
+SYSTEM_NODES = ("system_node", "controller_node", "localizer_node", "planner_node",
+                "maps_manager_node", "sensors_node", "recovery_node")
+
+
+def test_a_simulator_restarted_under_a_running_system_empties_its_transform_tree(
+    params_file, runtime_factory, ros
+):
+    """The TF listener runs on system_node's simulated time (its RT companion node is named in
+    no params file): when ``/clock`` goes back, the old run's transforms go and the new ones are
+    what a lookup returns. On the system time it never saw the jump: every transform of the
+    new run was refused as older than the window, and lookups gave the old run's pose. The age
+    of ``odom → base_footprint`` when served is measured on the same simulated clock."""
+    import time
+
+    from rosgraph_msgs.msg import Clock
+
+    from easynav.system.tf import TFBroadcaster
+
+    simulator = ros.create_node("simulator")
+    clock = simulator.create_publisher(Clock, "/clock", 10)
+    tf = TFBroadcaster(simulator)
+    origin = {"sim": 60.0, "mono": time.monotonic(), "x": 3.0}
+
+    def tick() -> None:
+        now = origin["sim"] + time.monotonic() - origin["mono"]
+        msg = Clock()
+        msg.clock.sec, msg.clock.nanosec = int(now), int((now % 1.0) * 1e9)
+        clock.publish(msg)
+        tf.send_transform(_odom_to_base(now, origin["x"]))
+
+    simulator.create_timer(0.01, tick)
+    path = params_file(system_params(**{f"{n}.use_sim_time": True for n in SYSTEM_NODES}))
+    runtime = runtime_factory(path)
+    assert runtime.start(), runtime.error
+    node = runtime.system_node
+    assert node.rt_io_node.get_parameter("use_sim_time").value is True
+    buffer = get_tf_buffer("")
+
+    def newest() -> tuple[float, float]:
+        stamp, values = buffer.lookup_transform_values("odom", "base_footprint")
+        return stamp, values[0]
+
+    assert ros.spin_until(lambda: buffer.frame_exists("base_footprint") and newest()[0] > 60.5)
+    origin.update(sim=1.0, mono=time.monotonic(), x=0.5)  # the simulator restarted
+    assert ros.spin_until(lambda: newest()[0] < 30.0, timeout=3.0), newest()
+    assert newest()[1] == 0.5
+    median, _, _ = node.tf_listener.odometry_age.summary()
+    assert -0.05 < median < 1.0  # seconds, simulated stamps against the simulated clock
+
+    # use_sim_time switched off on system_node at run time: its companion follows.
+    node.set_parameters([Parameter("use_sim_time", value=False)])
+    assert node.rt_io_node.get_parameter("use_sim_time").value is False

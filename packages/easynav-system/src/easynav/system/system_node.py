@@ -8,6 +8,7 @@ from typing import Any
 
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import String
 
@@ -107,7 +108,17 @@ class SystemNode(LifecycleNode):
         self.add_extension(self.reconfiguration)
         # A hidden companion node spun by the RT loop: what system_node receives on the RT side
         # (the safety channel's status, TF). rclpy serves a node from one executor only.
-        self.rt_io_node = Node("_system_node_rt", namespace=namespace, **kwargs)
+        # It keeps system_node's time (use_sim_time, now and whenever it changes): a params
+        # file names system_node, not it, and on the system time its TF listener never saw a
+        # simulator restart (the buffer kept the old run's transforms) and measured the age of
+        # simulated stamps against the wall clock.
+        rt_kwargs = dict(kwargs)
+        rt_kwargs["parameter_overrides"] = [
+            *kwargs.get("parameter_overrides", []),
+            Parameter("use_sim_time", value=self.get_parameter("use_sim_time").value),
+        ]
+        self.rt_io_node = Node("_system_node_rt", namespace=namespace, **rt_kwargs)
+        self.add_post_set_parameters_callback(self._share_sim_time)
         self.system.rt_node = self.rt_io_node  # plugins' RT-side subscriptions (odometry)
         # One /clock subscription for the eight nodes instead of eight: sensors_node's (the RT
         # loop serves it; the ROS graph check sees an EasyNav node waiting for /clock).
@@ -121,6 +132,12 @@ class SystemNode(LifecycleNode):
         self.tf_listener = TFListener(self.rt_io_node)
         self.safety = SafetySupervisor(self, self.rt_io_node)
         self.add_extension(self.safety)
+
+    def _share_sim_time(self, parameters: list[Parameter]) -> None:
+        """system_node's use_sim_time changed: its RT companion follows."""
+        for parameter in parameters:
+            if parameter.name == "use_sim_time":
+                self.rt_io_node.set_parameters([Parameter("use_sim_time", value=parameter.value)])
 
     def _ns_key(self) -> str:
         return self.get_namespace().strip("/")
