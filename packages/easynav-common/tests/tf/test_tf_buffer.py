@@ -113,6 +113,23 @@ def test_static_chain_holds_at_any_time_and_reports_stamp_zero():
     assert buffer.lookup_transform("base_link", "laser").header.stamp == 0.0
 
 
+def test_clear_forgets_everything_or_with_keep_static_only_the_dynamic_transforms():
+    """A time jump keeps the static transforms (their publishers do not send them again), a
+    new system forgets everything; either way the new time line's transforms are taken."""
+    buffer = TFBuffer()
+    robot_tree(buffer)
+    buffer.clear(keep_static=True)
+    assert buffer.frames() == ["base_link", "laser", "map", "odom"]
+    assert not buffer.can_transform("odom", "base_link")
+    np.testing.assert_allclose(buffer.lookup_transform("base_link", "laser").transform.translation,
+                               (0.2, 0.0, 0.3))
+    # the new time line, from 1 s: older than the old window, taken all the same
+    buffer.set_transform_values("odom", "base_link", 1.0, yaw_values(5.0, 0.0, 0.0), "t")
+    assert buffer.lookup_transform("map", "laser").header.stamp == 1.0
+    buffer.clear()
+    assert buffer.frames() == []
+
+
 def test_dynamic_lookup_outside_the_range_is_an_extrapolation_error_naming_everything():
     buffer = TFBuffer()
     robot_tree(buffer)

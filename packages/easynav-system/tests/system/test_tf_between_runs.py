@@ -3,6 +3,8 @@ with an empty transform tree: the earlier run's transforms are on another time l
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from rclpy.parameter import Parameter
@@ -50,19 +52,24 @@ def test_a_simulator_restarted_under_a_running_system_empties_its_transform_tree
     params_file, runtime_factory, ros
 ):
     """The TF listener runs on system_node's simulated time (its RT companion node is named in
-    no params file): when ``/clock`` goes back, the old run's transforms go and the new ones are
-    what a lookup returns. On the system time it never saw the jump: every transform of the
-    new run was refused as older than the window, and lookups gave the old run's pose. The age
-    of ``odom → base_footprint`` when served is measured on the same simulated clock."""
+    no params file): when ``/clock`` goes back, the old run's dynamic transforms go and the new
+    ones are what a lookup returns; the static ones stay (their publisher sends them once). On
+    the system time it never saw the jump: every transform of the new run was refused as older
+    than the window, and lookups gave the old run's pose. The age of ``odom → base_footprint``
+    when served is measured on the same simulated clock."""
     import time
 
     from rosgraph_msgs.msg import Clock
 
-    from easynav.system.tf import TFBroadcaster
+    from easynav.system.tf import StaticTFBroadcaster, TFBroadcaster
 
     simulator = ros.create_node("simulator")
     clock = simulator.create_publisher(Clock, "/clock", 10)
     tf = TFBroadcaster(simulator)
+    static = StaticTFBroadcaster(simulator)
+    static.send_transform(TransformStamped(
+        Header(0.0, "base_footprint"), "laser",
+        Transform(np.array((0.2, 0.0, 0.3)), np.array((0.0, 0.0, 0.0, 1.0)))))
     origin = {"sim": 60.0, "mono": time.monotonic(), "x": 3.0}
 
     def tick() -> None:
@@ -81,16 +88,22 @@ def test_a_simulator_restarted_under_a_running_system_empties_its_transform_tree
     buffer = get_tf_buffer("")
 
     def newest() -> tuple[float, float]:
-        stamp, values = buffer.lookup_transform_values("odom", "base_footprint")
+        try:
+            stamp, values = buffer.lookup_transform_values("odom", "base_footprint")
+        except LookupError:  # just cleared, nothing new yet
+            return math.nan, math.nan
         return stamp, values[0]
 
-    assert ros.spin_until(lambda: buffer.frame_exists("base_footprint") and newest()[0] > 60.5)
+    assert ros.spin_until(lambda: newest()[0] > 60.5 and buffer.frame_exists("laser"))
     origin.update(sim=1.0, mono=time.monotonic(), x=0.5)  # the simulator restarted
     assert ros.spin_until(lambda: newest()[0] < 30.0, timeout=3.0), newest()
     assert newest()[1] == 0.5
+    assert buffer.can_transform("odom", "laser")  # the static transform stayed
     median, _, _ = node.tf_listener.odometry_age.summary()
     assert -0.05 < median < 1.0  # seconds, simulated stamps against the simulated clock
 
-    # use_sim_time switched off on system_node at run time: its companion follows.
+    # use_sim_time switched off on system_node at run time: its companion follows (its clock
+    # changes source: the dynamic transforms go, the static one stays).
     node.set_parameters([Parameter("use_sim_time", value=False)])
     assert node.rt_io_node.get_parameter("use_sim_time").value is False
+    assert buffer.frame_exists("laser")

@@ -148,26 +148,38 @@ def test_time_jumping_back_clears_the_buffer_so_the_new_run_is_used(ros_local):
 
 def test_the_listener_records_how_old_the_robots_odometry_transform_was_when_served(ros_local):
     """The age of ``odom → base_footprint`` at its callback (the node's clock minus the stamp)
-    is what every pose lookup lags behind: logged at deactivation, read by the demo's summary.
-    Other transforms (a localizer's own ``map → odom``, stamped in the past) are not counted."""
+    is what every pose lookup lags behind: measured from ``start_odometry_age`` (system_node's
+    activation) for the transforms stamped since, logged at deactivation, read by the demo's
+    summary. Other transforms (a localizer's own ``map → odom``, stamped in the past) and
+    those queued from before the start are not counted."""
     from easynav.system.tf.tf_listener import ODOMETRY_AGE_PATTERN
 
     publisher = ros_local.create_node("age_pub")
     listener_node = ros_local.create_node("age_sub")
     buffer = TFBuffer()
     listener = TFListener(listener_node, buffer)
-    assert listener.describe_odometry_age() is None
     dynamic = TFBroadcaster(publisher)
     ros_local.spin_until(lambda: publisher.count_subscribers("tf") > 0)
     now = listener_node.get_clock().now().nanoseconds * 1e-9
-    dynamic.send_transform(_ts("map", "odom", now - 5.0, 1.0))
-    dynamic.send_transform([_ts("odom", "base_footprint", now - 0.3, 1.0),
-                            _ts("base_footprint", "wheel", now - 9.0, 1.0)])
+    dynamic.send_transform(_ts("odom", "base_footprint", now - 0.1, 1.0))  # not measuring yet
     assert ros_local.spin_until(lambda: buffer.frame_exists("base_footprint"), 5.0)
+    listener.start_odometry_age()
+    assert listener.describe_odometry_age() is None
+    dynamic.send_transform(_ts("map", "odom", now + 0.5, 1.0))
+    dynamic.send_transform(_ts("odom", "base_footprint", now - 5.0, 1.0))  # from before start
+    start = listener_node.get_clock().now().nanoseconds * 1e-9
+    dynamic.send_transform([_ts("base_footprint", "wheel", start, 1.0),
+                            _ts("odom", "base_footprint", start, 2.0)])
+    assert ros_local.spin_until(lambda: buffer.frame_exists("wheel"), 5.0)
     ros_local.spin_for(0.1)
     assert listener.odometry_age.count == 1
     median, _, worst = listener.odometry_age.summary()
-    assert 0.3 <= median == worst < 1.3  # served within a second of being sent
-    match = ODOMETRY_AGE_PATTERN.search(listener.describe_odometry_age())
+    assert 0.0 <= median == worst < 1.0  # served within a second of being sent
+    line = listener.stop_odometry_age()
+    match = ODOMETRY_AGE_PATTERN.search(line)
     assert (match["parent"], match["child"], match["count"]) == ("odom", "base_footprint", "1")
+    dynamic.send_transform(_ts("odom", "base_footprint", start + 0.1, 3.0))  # stopped
+    assert ros_local.spin_until(
+        lambda: buffer.lookup_transform("odom", "base_footprint").transform.translation[0] == 3.0)
+    assert listener.odometry_age.count == 1
     listener.destroy()

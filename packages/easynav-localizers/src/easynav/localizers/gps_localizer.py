@@ -320,8 +320,9 @@ class GpsLocalizer(LocalizerMethodBase):
     def _send_map_to_odom(self, x: float, y: float, fix_stamp: float, yaw: float,
                           yaw_stamp: float | None, yaw_rate: float, taken: int,
                           latest: tuple[float, tuple[float, ...]] | None) -> None:
-        """``map → odom`` that puts the robot at the estimate, anchored once per fix taken:
-        the fix's position with ``odom → robot`` at its stamp, the rotation from the IMU
+        """``map → odom`` that puts the robot at the estimate (nothing while ``latest``, the
+        newest ``odom → robot`` from :meth:`_latest_odometry`, is None), anchored once per fix
+        taken: the fix's position with ``odom → robot`` at its stamp, the rotation from the IMU
         filter's yaw with odometry's yaw at one instant (the yaw moved back by the gyro to the
         newest odometry when the IMU is ahead of it). Re-sent stamped with the newest
         ``odom → robot``, so that between fixes and through an outage the TF tree's robot

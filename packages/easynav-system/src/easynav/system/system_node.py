@@ -114,7 +114,7 @@ class SystemNode(LifecycleNode):
         # simulated stamps against the wall clock.
         rt_kwargs = dict(kwargs)
         rt_kwargs["parameter_overrides"] = [
-            *kwargs.get("parameter_overrides", []),
+            *(kwargs.get("parameter_overrides") or []),
             Parameter("use_sim_time", value=self.get_parameter("use_sim_time").value),
         ]
         self.rt_io_node = Node("_system_node_rt", namespace=namespace, **rt_kwargs)
@@ -134,7 +134,12 @@ class SystemNode(LifecycleNode):
         self.add_extension(self.safety)
 
     def _share_sim_time(self, parameters: list[Parameter]) -> None:
-        """system_node's use_sim_time changed: its RT companion follows."""
+        """system_node's use_sim_time changed: its RT companion follows.
+
+        Thread contract: runs in the thread that set system_node's parameters (the non-RT
+        loop for the parameter service); switching the companion's clock runs its TF
+        listener's jump callback (a locked clear) in that thread too. rclpy's parameter
+        handling raises nothing here for a bool system_node accepted already."""
         for parameter in parameters:
             if parameter.name == "use_sim_time":
                 self.rt_io_node.set_parameters([Parameter("use_sim_time", value=parameter.value)])
@@ -286,6 +291,7 @@ class SystemNode(LifecycleNode):
             self.subnodes[name].trigger_activate()
         for ext in self.extensions:
             ext.activate()
+        self.tf_listener.start_odometry_age()
         self.active = True
         return super().on_activate(state)
 
@@ -297,7 +303,7 @@ class SystemNode(LifecycleNode):
             node = self.subnodes[name]
             if node.lifecycle_state() == "active":
                 node.trigger_deactivate()
-        line = self.tf_listener.describe_odometry_age()
+        line = self.tf_listener.stop_odometry_age()
         if line is not None:
             self.get_logger().info(line)
         return super().on_deactivate(state)

@@ -110,11 +110,17 @@ class TFBuffer:
         with self._lock:
             return self._tf_info
 
-    def clear(self) -> None:
-        """Forget every transform (e.g. when simulated time jumps back)."""
+    def clear(self, keep_static: bool = False) -> None:
+        """Forget every transform (a new system starting in this process), or with
+        ``keep_static`` only the dynamic ones (simulated time jumped back). Static transforms
+        stay then, as in tf2's clear: they hold at every time, and their publishers send them
+        once per subscription (transient local), so they would not come again."""
         with self._lock:
+            kept = {c: h for c, h in self._frames.items() if keep_static and h.static}
             self._frames.clear()
+            self._frames.update(kept)
             self._parents.clear()
+            self._parents.update(h.parent for h in kept.values())
             self._chains.clear()
 
     # -- writing ----------------------------------------------------------------------------

@@ -18,6 +18,10 @@ ODOMETRY_AGE_PATTERN = re.compile(
 )
 
 
+#: The ``odom → robot`` ages :attr:`TFListener.odometry_age` keeps: 33 min at 50 Hz.
+ODOMETRY_AGE_SAMPLES = 100_000
+
+
 class TFListener:
     """Subscribes ``tf`` (reliable, depth 100) and ``tf_static`` (reliable, transient-local).
 
@@ -26,15 +30,28 @@ class TFListener:
     Callbacks run in whichever executor spins ``node`` (``callback_group`` chooses the group).
 
     When the node's clock jumps back (a simulator or a bag restarted) or switches between
-    system and simulated time, the buffer is cleared, as tf2's buffer does: the transforms
+    system and simulated time, the dynamic transforms are cleared, as tf2's buffer does: those
     stamped on the old time line would otherwise be taken for the newest for up to the cache
-    window, and every new one refused as too old.
+    window, and every new one refused as too old. Static transforms stay (as in tf2): they hold
+    at every time, and their publishers send them once per subscription.
 
-    Thread contract: construct and ``destroy`` in the node's configuring thread; the callbacks
-    only call :meth:`TFBuffer.set_transform_values`, which is locked; the clock's jump
-    callback (in whichever thread sets the clock) only calls :meth:`TFBuffer.clear`, locked
-    too. A bad transform in a message is rejected by the buffer with a warning; the rest of
-    the message is still used.
+    Between :meth:`start_odometry_age` and :meth:`stop_odometry_age` (system_node's activation
+    and deactivation) ``odometry_age`` records how old each ``odom → robot`` transform stamped
+    since the start was when its message was served: the node's clock minus the stamp. It is
+    the transport's delay plus the backlog of the executor that serves the listener (the RT
+    loop's): what every lookup of the robot's pose lags behind the robot. Transforms stamped
+    before the start (queued while no loop served the listener, during configuration) are not
+    counted. On simulated time the age is in simulated seconds: at twice real time a backlog of
+    10 ms of wall time reads 20 ms.
+
+    Thread contract: construct and ``destroy`` in the node's configuring thread;
+    :meth:`start_odometry_age` and :meth:`stop_odometry_age` in its lifecycle thread. The
+    callbacks call the locked :meth:`TFBuffer.set_transform_values` and
+    :meth:`TFBuffer.get_tf_info`, read the node's clock and record into ``odometry_age``
+    (unlocked: a reader while they run may see a torn last value); the clock's jump callback
+    (in whichever thread sets the clock) calls :meth:`TFBuffer.clear`, locked too. A bad
+    transform in a message is rejected by the buffer with a warning; the rest of the message
+    is still used.
     """
 
     def __init__(
@@ -50,7 +67,8 @@ class TFListener:
 
         self.buffer = buffer if buffer is not None else get_tf_buffer(node.get_namespace())
         self._node = node
-        self.odometry_age = CycleTimes()
+        self.odometry_age = CycleTimes(ODOMETRY_AGE_SAMPLES)
+        self._age_since: float | None = None  # node-clock seconds; None: not measuring
         dynamic_qos = QoSProfile(
             depth=100,
             reliability=ReliabilityPolicy.RELIABLE,
@@ -91,21 +109,43 @@ class TFListener:
         else:
             return
         if self.buffer.frames():
-            self._node.get_logger().warning(f"{reason}: clearing the TF buffer")
-        self.buffer.clear()
+            self._node.get_logger().warning(
+                f"{reason}: clearing the TF buffer's dynamic transforms")
+        self.buffer.clear(keep_static=True)
+        if self._age_since is not None:  # the new time line's transforms count
+            self._age_since = self._now()
+
+    def _now(self) -> float:
+        return self._node.get_clock().now().nanoseconds * 1e-9
 
     def _on_tf(self, msg: Any) -> None:
         self._store(msg, "tf", False)
-        robot = self.buffer.get_tf_info().robot_footprint_frame
+        since = self._age_since
+        if since is None:
+            return
+        info = self.buffer.get_tf_info()
         for ts in msg.transforms:
-            if ts.child_frame_id == robot:
-                now = self._node.get_clock().now().nanoseconds * 1e-9
-                self.odometry_age.record(now - stamp_to_seconds(ts.header.stamp))
+            if (ts.child_frame_id.lstrip("/") == info.robot_footprint_frame
+                    and ts.header.frame_id.lstrip("/") == info.odom_frame):
+                stamp = stamp_to_seconds(ts.header.stamp)
+                if stamp >= since:
+                    self.odometry_age.record(self._now() - stamp)
                 break
+
+    def start_odometry_age(self) -> None:
+        """Record ``odometry_age`` afresh, for the transforms stamped from now on."""
+        self.odometry_age = CycleTimes(ODOMETRY_AGE_SAMPLES)
+        self._age_since = self._now()
+
+    def stop_odometry_age(self) -> str | None:
+        """Stop recording; :meth:`describe_odometry_age` of what was recorded."""
+        self._age_since = None
+        return self.describe_odometry_age()
 
     def describe_odometry_age(self) -> str | None:
         """One log line (matching :data:`ODOMETRY_AGE_PATTERN`) on ``odometry_age``; None
-        before the first ``odom → robot`` transform."""
+        before the first ``odom → robot`` transform. The statistics cover the last
+        :data:`ODOMETRY_AGE_SAMPLES`; a torn last value is possible while the callback runs."""
         stats = self.odometry_age.summary()
         if stats is None:
             return None
