@@ -409,3 +409,32 @@ def test_an_unstamped_fix_is_carried_from_the_odometry_it_was_anchored_on():
     pose = nav_state.get("robot_pose", Odometry)
     assert pose.pose.x == pytest.approx(1.0, abs=1e-6)
     assert pose.pose_covariance[0, 0] == pytest.approx(0.15**2 + (ODOMETRY_DRIFT * 1.0)**2)
+
+
+def test_map_to_odom_and_robot_pose_come_from_one_look_at_odometry(monkeypatch):
+    """Odometry lands (in the RT thread) while an update runs: ``map → odom`` and robot_pose
+    are both from the one ``odom → robot`` sample the update looked at, stamped alike. Looked
+    up twice, robot_pose came from the newer sample while ``map → odom`` was stamped with the
+    older."""
+    from easynav.common.tf import get_tf_buffer
+
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin({"initial_pose.x": 10.0, "initial_pose.y": 5.0}, "gps_test_one_look")
+    buffer = get_tf_buffer("gps_test_one_look")
+    nav_state = NavState()
+    _odometry_line(buffer, [0.0, 0.1])
+    plugin.add_fix(_fix(projection, 0.1, 0.0, 0.1, sigma=0.15))
+    real = buffer.lookup_transform_values
+
+    def lookup(target, source, time=None):
+        result = real(target, source, time)
+        if (target, source, time) == ("odom", "base_footprint", None):
+            _odometry_line(buffer, [result[0] + 0.1])  # the next sample lands meanwhile
+        return result
+
+    monkeypatch.setattr(buffer, "lookup_transform_values", lookup)
+    plugin.update(nav_state)
+    pose = nav_state.get("robot_pose", Odometry)
+    sent, _ = real("map", "odom")
+    assert pose.header.stamp == pytest.approx(sent) == pytest.approx(0.1)
+    assert (pose.pose.x, pose.pose.y) == pytest.approx((10.0, 5.0), abs=1e-3)  # the fix
