@@ -130,6 +130,27 @@ def test_clear_forgets_everything_or_with_keep_static_only_the_dynamic_transform
     assert buffer.frames() == []
 
 
+def test_after_a_clear_with_refuse_after_the_old_time_line_is_refused_until_the_new_one_gets_there(
+    caplog,
+):
+    """The clock jumped back from 60 s to 0 s: transforms stamped after 30 s (still queued
+    from the old run) are refused with a warning, the new run's taken; once the new run's
+    transforms come within a second of 30 s the refusal ends. Static transforms are never
+    refused."""
+    buffer = TFBuffer()
+    buffer.set_transform_values("odom", "base_link", 60.0, yaw_values(5.0, 0.0, 0.0), "old")
+    buffer.clear(keep_static=True, refuse_after=30.0)
+    assert not buffer.set_transform_values("odom", "base_link", 60.05, yaw_values(5, 0, 0), "old")
+    assert "from before the clock jumped back" in caplog.text
+    assert buffer.set_transform_values("base_link", "laser", 99.0, (0, 0, 0, 0, 0, 0, 1), "s", True)
+    for t in (0.5, 10.0, 28.0):
+        assert buffer.set_transform_values("odom", "base_link", t, yaw_values(t, 0, 0), "new")
+    assert not buffer.set_transform_values("odom", "base_link", 31.0, yaw_values(0, 0, 0), "x")
+    assert buffer.set_transform_values("odom", "base_link", 29.5, yaw_values(29.5, 0, 0), "new")
+    assert buffer.set_transform_values("odom", "base_link", 31.0, yaw_values(31, 0, 0), "new")
+    assert buffer.lookup_transform("odom", "base_link").header.stamp == 31.0
+
+
 def test_dynamic_lookup_outside_the_range_is_an_extrapolation_error_naming_everything():
     buffer = TFBuffer()
     robot_tree(buffer)

@@ -146,6 +146,48 @@ def test_time_jumping_back_clears_the_buffer_so_the_new_run_is_used(ros_local):
     listener.destroy()
 
 
+def test_a_transform_of_the_old_time_line_served_after_the_jump_back_is_refused(ros_local):
+    """The simulator's last tick before a restart and its first after it are both queued when
+    the listener looks: ``/clock`` keeps only its newest message (the jump comes first), ``tf``
+    keeps both. The old run's transform, served after the clear, is refused; stored, it locked
+    the buffer on the old pose (every transform of the new run older than the window)."""
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+
+    listener_node = ros_local.create_node(
+        "late_listener", parameter_overrides=[Parameter("use_sim_time", value=True)]
+    )
+    simulator = ros_local.create_node("late_sim")
+    clock_pub = simulator.create_publisher(Clock, "/clock", 10)
+    buffer = TFBuffer()
+    listener = TFListener(listener_node, buffer)
+    dynamic = TFBroadcaster(simulator)
+
+    def tick(seconds: float, x: float) -> None:
+        msg = Clock()
+        msg.clock.sec, msg.clock.nanosec = int(seconds), round((seconds % 1.0) * 1e9)
+        clock_pub.publish(msg)
+        dynamic.send_transform(_ts("odom", "base_link", seconds, x))
+
+    def newest() -> float:
+        try:
+            return buffer.lookup_transform_values("odom", "base_link")[0]
+        except LookupError:
+            return math.nan
+
+    assert ros_local.spin_until(lambda: clock_pub.get_subscription_count() > 0)
+    assert ros_local.spin_until(lambda: simulator.count_subscribers("tf") > 0)
+    tick(60.0, 5.0)
+    assert ros_local.spin_until(lambda: newest() == 60.0)
+    tick(60.05, 5.0)  # the old run's last tick ...
+    tick(1.0, 0.5)  # ... and the restarted simulator's first, before the listener looks
+    assert ros_local.spin_until(lambda: newest() == 1.0, timeout=3.0), buffer.all_frames_as_string()
+    tick(1.01, 0.5)
+    assert ros_local.spin_until(lambda: newest() == 1.01)
+    assert buffer.lookup_transform("odom", "base_link").transform.translation[0] == 0.5
+    listener.destroy()
+
+
 def test_the_listener_records_how_old_the_robots_odometry_transform_was_when_served(ros_local):
     """The age of ``odom → base_footprint`` at its callback (the node's clock minus the stamp)
     is what every pose lookup lags behind: measured from ``start_odometry_age`` (system_node's

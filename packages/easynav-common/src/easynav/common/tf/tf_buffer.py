@@ -33,6 +33,9 @@ from easynav.core.robot.tf_info import TFInfo
 from easynav.core.types import Header, Transform, TransformStamped
 
 _MAX_DEPTH = 1000  # a tree deeper than this is a loop in the data, not a robot
+#: After a clear with ``refuse_after``: the refusal ends once the new time line's own
+#: transforms come this close to it (their senders' queues drained long before).
+_REFUSAL_LIFT_MARGIN = 1.0  # s
 _WARN_PERIOD_S = 5.0
 
 
@@ -73,6 +76,7 @@ class TFBuffer:
         self._has_tf_info = False
         self._logger = logger if logger is not None else logging.getLogger("easynav.tf")
         self._last_warning: dict[tuple[str, str, str], float] = {}
+        self._refuse_after: float | None = None  # see clear()
 
     # -- configuration ----------------------------------------------------------------------
     @property
@@ -110,11 +114,18 @@ class TFBuffer:
         with self._lock:
             return self._tf_info
 
-    def clear(self, keep_static: bool = False) -> None:
+    def clear(self, keep_static: bool = False, refuse_after: float | None = None) -> None:
         """Forget every transform (a new system starting in this process), or with
         ``keep_static`` only the dynamic ones (simulated time jumped back). Static transforms
         stay then, as in tf2's clear: they hold at every time, and their publishers send them
-        once per subscription (transient local), so they would not come again."""
+        once per subscription (transient local), so they would not come again.
+
+        ``refuse_after`` (the time jumped back): dynamic transforms stamped after it are
+        refused from now on, until the new time line's own transforms come within
+        ``_REFUSAL_LIFT_MARGIN`` of it. A transform of the old time line still queued when
+        the clock jumped (a subscription's backlog, a localizer's write computed just before)
+        would otherwise be stored after the clear, and every transform of the new time line
+        refused as older than the window for as long as the jump."""
         with self._lock:
             kept = {c: h for c, h in self._frames.items() if keep_static and h.static}
             self._frames.clear()
@@ -122,6 +133,7 @@ class TFBuffer:
             self._parents.clear()
             self._parents.update(h.parent for h in kept.values())
             self._chains.clear()
+            self._refuse_after = refuse_after
 
     # -- writing ----------------------------------------------------------------------------
     def set_transform(
@@ -174,15 +186,26 @@ class TFBuffer:
             )
             return False
         with self._lock:
-            history = self._frames.get(child)
-            if history is None or history.parent != parent or history.static != is_static:
-                history = FrameHistory(child, parent, is_static, authority)
-                self._frames[child] = history
-                self._parents.add(parent)
-                self._chains.clear()  # the tree changed shape: cached chains are wrong now
-            history.authority = authority
-            stored = history.insert(float(stamp), clean, self._cache_time)
-            oldest = history.oldest
+            refuse_after = self._refuse_after
+            refused = refuse_after is not None and not is_static and stamp > refuse_after
+            if not refused:
+                if (refuse_after is not None and not is_static
+                        and stamp >= refuse_after - _REFUSAL_LIFT_MARGIN):
+                    self._refuse_after = None  # the new time line got here
+                history = self._frames.get(child)
+                if history is None or history.parent != parent or history.static != is_static:
+                    history = FrameHistory(child, parent, is_static, authority)
+                    self._frames[child] = history
+                    self._parents.add(parent)
+                    self._chains.clear()  # the tree changed shape: cached chains are wrong now
+                history.authority = authority
+                stored = history.insert(float(stamp), clean, self._cache_time)
+                oldest = history.oldest
+        if refused:
+            self._warn(parent, child, authority,
+                       f"ignored: stamp {stamp:.3f} is from before the clock jumped back (the "
+                       f"old time line: after {refuse_after:.3f})")
+            return False
         if not stored:
             self._warn(
                 parent,

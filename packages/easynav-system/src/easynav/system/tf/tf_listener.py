@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import threading
 from typing import Any
 
 from easynav.common.tf.tf_buffer import TFBuffer
@@ -33,7 +34,12 @@ class TFListener:
     system and simulated time, the dynamic transforms are cleared, as tf2's buffer does: those
     stamped on the old time line would otherwise be taken for the newest for up to the cache
     window, and every new one refused as too old. Static transforms stay (as in tf2): they hold
-    at every time, and their publishers send them once per subscription.
+    at every time, and their publishers send them once per subscription. Transforms of the
+    old time line that arrive after the clear (this subscription's backlog: ``/clock`` keeps
+    only its newest message, ``tf`` up to 100) are refused (``TFBuffer.clear``'s
+    ``refuse_after``): those stamped over halfway back to where the clock was, or on the
+    system time after a switch to simulated time. Stored, they locked the buffer on the old
+    run's pose for as long as the jump (tf2 has the same weakness).
 
     Between :meth:`start_odometry_age` and :meth:`stop_odometry_age` (system_node's activation
     and deactivation) ``odometry_age`` records how old each ``odom → robot`` transform stamped
@@ -49,7 +55,8 @@ class TFListener:
     callbacks call the locked :meth:`TFBuffer.set_transform_values` and
     :meth:`TFBuffer.get_tf_info`, read the node's clock and record into ``odometry_age``
     (unlocked: a reader while they run may see a torn last value); the clock's jump callback
-    (in whichever thread sets the clock) calls :meth:`TFBuffer.clear`, locked too. A bad
+    (in whichever thread sets the clock) calls :meth:`TFBuffer.clear`, locked too, and moves
+    the start of the measure under the lock that start and stop take. A bad
     transform in a message is rejected by the buffer with a warning; the rest of the message
     is still used.
     """
@@ -69,6 +76,7 @@ class TFListener:
         self._node = node
         self.odometry_age = CycleTimes(ODOMETRY_AGE_SAMPLES)
         self._age_since: float | None = None  # node-clock seconds; None: not measuring
+        self._age_lock = threading.Lock()  # start, stop and a clock jump: not the callback
         dynamic_qos = QoSProfile(
             depth=100,
             reliability=ReliabilityPolicy.RELIABLE,
@@ -100,20 +108,33 @@ class TFListener:
         )
 
     def _on_time_jump(self, jump: Any) -> None:
+        import time
+
         from rclpy.clock import ClockChange
 
-        if jump.clock_change in (ClockChange.ROS_TIME_ACTIVATED, ClockChange.ROS_TIME_DEACTIVATED):
-            reason = "the time source changed"
+        now = self._now()
+        if jump.clock_change == ClockChange.ROS_TIME_ACTIVATED:
+            reason = "the clock switched to simulated time"
+            # Transforms stamped on the system time, still queued, are refused.
+            refuse_after = time.time() - self.buffer.cache_time
+        elif jump.clock_change == ClockChange.ROS_TIME_DEACTIVATED:
+            reason = "the clock switched to the system time"
+            refuse_after = None  # queued simulated stamps are older than the new ones
         elif jump.delta.nanoseconds < 0:
-            reason = f"time jumped back {-jump.delta.nanoseconds * 1e-9:.3f} s"
+            back = -jump.delta.nanoseconds * 1e-9
+            reason = f"time jumped back {back:.3f} s"
+            # Queued transforms of the old time line are refused: those stamped over halfway
+            # back to where the clock was.
+            refuse_after = now + 0.5 * back
         else:
             return
         if self.buffer.frames():
             self._node.get_logger().warning(
                 f"{reason}: clearing the TF buffer's dynamic transforms")
-        self.buffer.clear(keep_static=True)
-        if self._age_since is not None:  # the new time line's transforms count
-            self._age_since = self._now()
+        self.buffer.clear(keep_static=True, refuse_after=refuse_after)
+        with self._age_lock:
+            if self._age_since is not None:  # the new time line's transforms count
+                self._age_since = now
 
     def _now(self) -> float:
         return self._node.get_clock().now().nanoseconds * 1e-9
@@ -127,19 +148,29 @@ class TFListener:
         for ts in msg.transforms:
             if (ts.child_frame_id.lstrip("/") == info.robot_footprint_frame
                     and ts.header.frame_id.lstrip("/") == info.odom_frame):
+                now = self._now()
+                if since <= 0.0:  # started before the first /clock: from the first reading
+                    if now <= 0.0:
+                        return
+                    self._age_since = since = now
                 stamp = stamp_to_seconds(ts.header.stamp)
-                if stamp >= since:
-                    self.odometry_age.record(self._now() - stamp)
+                # Not counted: stamped before the start, or ahead of the clock by more than
+                # a second (another time line: a transform queued across a clock jump).
+                if since <= stamp <= now + 1.0:
+                    self.odometry_age.record(now - stamp)
                 break
 
     def start_odometry_age(self) -> None:
-        """Record ``odometry_age`` afresh, for the transforms stamped from now on."""
-        self.odometry_age = CycleTimes(ODOMETRY_AGE_SAMPLES)
-        self._age_since = self._now()
+        """Record ``odometry_age`` afresh, for the transforms stamped from now on (on
+        simulated time before the first ``/clock``: from its first reading)."""
+        with self._age_lock:
+            self.odometry_age = CycleTimes(ODOMETRY_AGE_SAMPLES)
+            self._age_since = self._now()
 
     def stop_odometry_age(self) -> str | None:
         """Stop recording; :meth:`describe_odometry_age` of what was recorded."""
-        self._age_since = None
+        with self._age_lock:
+            self._age_since = None
         return self.describe_odometry_age()
 
     def describe_odometry_age(self) -> str | None:
