@@ -151,6 +151,20 @@ def test_after_a_clear_with_refuse_after_the_old_time_line_is_refused_until_the_
     assert buffer.lookup_transform("odom", "base_link").header.stamp == 31.0
 
 
+def test_the_refusal_after_a_clear_ends_after_a_few_seconds_whatever_the_stamps(monkeypatch):
+    """Transforms stamped on another clock than the listener's (a driver on the system time
+    under simulated time) are refused only while a backlog could still drain."""
+    from easynav.common.tf import tf_buffer
+
+    now = [100.0]
+    monkeypatch.setattr(tf_buffer._time, "monotonic", lambda: now[0])
+    buffer = TFBuffer()
+    buffer.clear(keep_static=True, refuse_after=30.0)
+    assert not buffer.set_transform_values("odom", "base_link", 1.8e9, yaw_values(0, 0, 0), "w")
+    now[0] += tf_buffer._REFUSAL_MAX_WALL + 0.1
+    assert buffer.set_transform_values("odom", "base_link", 1.8e9, yaw_values(0, 0, 0), "w")
+
+
 def test_dynamic_lookup_outside_the_range_is_an_extrapolation_error_naming_everything():
     buffer = TFBuffer()
     robot_tree(buffer)

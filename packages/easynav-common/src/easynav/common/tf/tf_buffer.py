@@ -36,6 +36,10 @@ _MAX_DEPTH = 1000  # a tree deeper than this is a loop in the data, not a robot
 #: After a clear with ``refuse_after``: the refusal ends once the new time line's own
 #: transforms come this close to it (their senders' queues drained long before).
 _REFUSAL_LIFT_MARGIN = 1.0  # s
+#: ... or after this long on the monotonic clock: a backlog drains in well under that (1.3 s
+#: seen under heavy load), and transforms stamped on another clock than the listener's (a
+#: misconfigured driver) are not refused for good.
+_REFUSAL_MAX_WALL = 5.0  # s
 _WARN_PERIOD_S = 5.0
 
 
@@ -77,6 +81,7 @@ class TFBuffer:
         self._logger = logger if logger is not None else logging.getLogger("easynav.tf")
         self._last_warning: dict[tuple[str, str, str], float] = {}
         self._refuse_after: float | None = None  # see clear()
+        self._refuse_until = 0.0  # monotonic seconds
 
     # -- configuration ----------------------------------------------------------------------
     @property
@@ -122,10 +127,11 @@ class TFBuffer:
 
         ``refuse_after`` (the time jumped back): dynamic transforms stamped after it are
         refused from now on, until the new time line's own transforms come within
-        ``_REFUSAL_LIFT_MARGIN`` of it. A transform of the old time line still queued when
-        the clock jumped (a subscription's backlog, a localizer's write computed just before)
-        would otherwise be stored after the clear, and every transform of the new time line
-        refused as older than the window for as long as the jump."""
+        ``_REFUSAL_LIFT_MARGIN`` of it, for ``_REFUSAL_MAX_WALL`` at most. A transform of the
+        old time line still queued when the clock jumped (a subscription's backlog, a
+        localizer's write computed just before) would otherwise be stored after the clear, and
+        every transform of the new time line refused as older than the window for as long as
+        the jump."""
         with self._lock:
             kept = {c: h for c, h in self._frames.items() if keep_static and h.static}
             self._frames.clear()
@@ -134,6 +140,7 @@ class TFBuffer:
             self._parents.update(h.parent for h in kept.values())
             self._chains.clear()
             self._refuse_after = refuse_after
+            self._refuse_until = _time.monotonic() + _REFUSAL_MAX_WALL
 
     # -- writing ----------------------------------------------------------------------------
     def set_transform(
@@ -187,6 +194,8 @@ class TFBuffer:
             return False
         with self._lock:
             refuse_after = self._refuse_after
+            if refuse_after is not None and _time.monotonic() > self._refuse_until:
+                refuse_after = self._refuse_after = None
             refused = refuse_after is not None and not is_static and stamp > refuse_after
             if not refused:
                 if (refuse_after is not None and not is_static
