@@ -130,39 +130,38 @@ def test_clear_forgets_everything_or_with_keep_static_only_the_dynamic_transform
     assert buffer.frames() == []
 
 
-def test_after_a_clear_with_refuse_after_the_old_time_line_is_refused_until_the_new_one_gets_there(
-    caplog,
+def test_after_a_clear_with_refuse_after_the_old_time_line_is_refused_until_ended(
+    caplog, monkeypatch
 ):
     """The clock jumped back from 60 s to 0 s: transforms stamped after 30 s (still queued
-    from the old run) are refused with a warning, the new run's taken; once the new run's
-    transforms come within a second of 30 s the refusal ends. Static transforms are never
+    from the old run) are refused with a warning, the new run's taken, until the listener ends
+    the refusal (its clock got to 30 s) or 5 s of monotonic time passed (transforms stamped on
+    another clock than the listener's are not refused for good). Static transforms are never
     refused."""
-    buffer = TFBuffer()
-    buffer.set_transform_values("odom", "base_link", 60.0, yaw_values(5.0, 0.0, 0.0), "old")
-    buffer.clear(keep_static=True, refuse_after=30.0)
-    assert not buffer.set_transform_values("odom", "base_link", 60.05, yaw_values(5, 0, 0), "old")
-    assert "from before the clock jumped back" in caplog.text
-    assert buffer.set_transform_values("base_link", "laser", 99.0, (0, 0, 0, 0, 0, 0, 1), "s", True)
-    for t in (0.5, 10.0, 28.0):
-        assert buffer.set_transform_values("odom", "base_link", t, yaw_values(t, 0, 0), "new")
-    assert not buffer.set_transform_values("odom", "base_link", 31.0, yaw_values(0, 0, 0), "x")
-    assert buffer.set_transform_values("odom", "base_link", 29.5, yaw_values(29.5, 0, 0), "new")
-    assert buffer.set_transform_values("odom", "base_link", 31.0, yaw_values(31, 0, 0), "new")
-    assert buffer.lookup_transform("odom", "base_link").header.stamp == 31.0
-
-
-def test_the_refusal_after_a_clear_ends_after_a_few_seconds_whatever_the_stamps(monkeypatch):
-    """Transforms stamped on another clock than the listener's (a driver on the system time
-    under simulated time) are refused only while a backlog could still drain."""
     from easynav.common.tf import tf_buffer
 
     now = [100.0]
-    monkeypatch.setattr(tf_buffer._time, "monotonic", lambda: now[0])
+    monkeypatch.setattr(tf_buffer, "_monotonic", lambda: now[0])
     buffer = TFBuffer()
+    buffer.set_transform_values("odom", "base_link", 60.0, yaw_values(5.0, 0.0, 0.0), "old")
+    buffer.clear(keep_static=True, refuse_after=30.0)
+    assert buffer.refusing_after == 30.0
+    assert not buffer.set_transform_values("odom", "base_link", 60.05, yaw_values(5, 0, 0), "old")
+    assert "refused: stamp 60.050 is on the time line before the clock changed" in caplog.text
+    assert buffer.set_transform_values("base_link", "laser", 99.0, (0, 0, 0, 0, 0, 0, 1), "s", True)
+    for t in (0.5, 10.0, 29.5):
+        assert buffer.set_transform_values("odom", "base_link", t, yaw_values(t, 0, 0), "new")
+    assert not buffer.set_transform_values("odom", "base_link", 31.0, yaw_values(0, 0, 0), "x")
+    buffer.end_refusal()
+    assert buffer.refusing_after is None
+    assert buffer.set_transform_values("odom", "base_link", 31.0, yaw_values(31, 0, 0), "new")
+    assert buffer.lookup_transform("odom", "base_link").header.stamp == 31.0
+
     buffer.clear(keep_static=True, refuse_after=30.0)
     assert not buffer.set_transform_values("odom", "base_link", 1.8e9, yaw_values(0, 0, 0), "w")
     now[0] += tf_buffer._REFUSAL_MAX_WALL + 0.1
     assert buffer.set_transform_values("odom", "base_link", 1.8e9, yaw_values(0, 0, 0), "w")
+    assert buffer.refusing_after is None
 
 
 def test_dynamic_lookup_outside_the_range_is_an_extrapolation_error_naming_everything():

@@ -33,13 +33,12 @@ from easynav.core.robot.tf_info import TFInfo
 from easynav.core.types import Header, Transform, TransformStamped
 
 _MAX_DEPTH = 1000  # a tree deeper than this is a loop in the data, not a robot
-#: After a clear with ``refuse_after``: the refusal ends once the new time line's own
-#: transforms come this close to it (their senders' queues drained long before).
-_REFUSAL_LIFT_MARGIN = 1.0  # s
-#: ... or after this long on the monotonic clock: a backlog drains in well under that (1.3 s
-#: seen under heavy load), and transforms stamped on another clock than the listener's (a
-#: misconfigured driver) are not refused for good.
+#: After a clear with ``refuse_after``, the refusal ends after this long on the monotonic clock
+#: at most (the listener ends it sooner, when its clock gets there): a backlog drains in well
+#: under that (1.3 s seen under heavy load), and transforms stamped on another clock than the
+#: listener's (a misconfigured driver) are not refused for good.
 _REFUSAL_MAX_WALL = 5.0  # s
+_monotonic = _time.monotonic  # the module's own name, for tests to replace
 _WARN_PERIOD_S = 5.0
 
 
@@ -125,13 +124,13 @@ class TFBuffer:
         stay then, as in tf2's clear: they hold at every time, and their publishers send them
         once per subscription (transient local), so they would not come again.
 
-        ``refuse_after`` (the time jumped back): dynamic transforms stamped after it are
-        refused from now on, until the new time line's own transforms come within
-        ``_REFUSAL_LIFT_MARGIN`` of it, for ``_REFUSAL_MAX_WALL`` at most. A transform of the
-        old time line still queued when the clock jumped (a subscription's backlog, a
-        localizer's write computed just before) would otherwise be stored after the clear, and
-        every transform of the new time line refused as older than the window for as long as
-        the jump."""
+        ``refuse_after`` (where the old time line begins): dynamic transforms stamped after
+        it are refused from now on, until :meth:`end_refusal` (the listener calls it when its
+        clock gets there) or ``_REFUSAL_MAX_WALL`` seconds have passed. A transform of the old
+        time line still queued when the clock jumped back (a subscription's backlog, a
+        localizer's write computed just before) would otherwise be stored after the clear:
+        the newest for as long as the jump, and for a jump longer than the window every
+        transform of the new time line refused as older than it."""
         with self._lock:
             kept = {c: h for c, h in self._frames.items() if keep_static and h.static}
             self._frames.clear()
@@ -140,7 +139,17 @@ class TFBuffer:
             self._parents.update(h.parent for h in kept.values())
             self._chains.clear()
             self._refuse_after = refuse_after
-            self._refuse_until = _time.monotonic() + _REFUSAL_MAX_WALL
+            self._refuse_until = _monotonic() + _REFUSAL_MAX_WALL
+
+    @property
+    def refusing_after(self) -> float | None:
+        """The stamp after which dynamic transforms are refused (see :meth:`clear`), or None."""
+        return self._refuse_after
+
+    def end_refusal(self) -> None:
+        """Take dynamic transforms of any stamp again (see :meth:`clear`)."""
+        with self._lock:
+            self._refuse_after = None
 
     # -- writing ----------------------------------------------------------------------------
     def set_transform(
@@ -149,7 +158,9 @@ class TFBuffer:
         """Store ``header.frame_id <- child_frame_id`` at ``header.stamp``.
 
         Returns False (with a warning naming the frames and ``authority``) when the transform is
-        not finite, has a zero quaternion or bad frame names, or is older than the window.
+        not finite, has a zero quaternion or bad frame names, is older than the window, or is
+        dynamic and stamped on the time line before a clock change (:meth:`clear`'s
+        ``refuse_after``).
         """
         tr = transform_stamped.transform
         t = tr.translation
@@ -194,13 +205,10 @@ class TFBuffer:
             return False
         with self._lock:
             refuse_after = self._refuse_after
-            if refuse_after is not None and _time.monotonic() > self._refuse_until:
+            if refuse_after is not None and _monotonic() > self._refuse_until:
                 refuse_after = self._refuse_after = None
             refused = refuse_after is not None and not is_static and stamp > refuse_after
             if not refused:
-                if (refuse_after is not None and not is_static
-                        and stamp >= refuse_after - _REFUSAL_LIFT_MARGIN):
-                    self._refuse_after = None  # the new time line got here
                 history = self._frames.get(child)
                 if history is None or history.parent != parent or history.static != is_static:
                     history = FrameHistory(child, parent, is_static, authority)
@@ -212,8 +220,8 @@ class TFBuffer:
                 oldest = history.oldest
         if refused:
             self._warn(parent, child, authority,
-                       f"ignored: stamp {stamp:.3f} is from before the clock jumped back (the "
-                       f"old time line: after {refuse_after:.3f})")
+                       f"refused: stamp {stamp:.3f} is on the time line before the clock "
+                       f"changed (after {refuse_after:.3f})")
             return False
         if not stored:
             self._warn(
@@ -240,7 +248,7 @@ class TFBuffer:
     def _warn(self, parent: str, child: str, authority: str, text: str) -> None:
         # Throttled per frame pair and kind: a broken publisher at 100 Hz must not flood the log.
         key = (parent, child, text.split(":", 1)[0])
-        now = _time.monotonic()
+        now = _monotonic()
         with self._lock:
             last = self._last_warning.get(key)
             if last is not None and now - last < _WARN_PERIOD_S:

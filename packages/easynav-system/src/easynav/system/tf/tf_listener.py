@@ -37,9 +37,11 @@ class TFListener:
     at every time, and their publishers send them once per subscription. Transforms of the
     old time line that arrive after the clear (this subscription's backlog: ``/clock`` keeps
     only its newest message, ``tf`` up to 100) are refused (``TFBuffer.clear``'s
-    ``refuse_after``): those stamped over halfway back to where the clock was, or on the
-    system time after a switch to simulated time. Stored, they locked the buffer on the old
-    run's pose for as long as the jump (tf2 has the same weakness).
+    ``refuse_after``) until the clock gets to where that time line begins (5 s at most):
+    stamps over halfway back to where the clock was, or, after a switch to simulated time,
+    within the cache window of the system time or later. Stored, one was the newest for as
+    long as the jump, and after a jump longer than the window every transform of the new run
+    was refused as older than it (tf2 has the same weakness).
 
     Between :meth:`start_odometry_age` and :meth:`stop_odometry_age` (system_node's activation
     and deactivation) ``odometry_age`` records how old each ``odom → robot`` transform stamped
@@ -55,8 +57,9 @@ class TFListener:
     callbacks call the locked :meth:`TFBuffer.set_transform_values` and
     :meth:`TFBuffer.get_tf_info`, read the node's clock and record into ``odometry_age``
     (unlocked: a reader while they run may see a torn last value); the clock's jump callback
-    (in whichever thread sets the clock) calls :meth:`TFBuffer.clear`, locked too, and moves
-    the start of the measure under the lock that start and stop take. A bad
+    (in whichever thread sets the clock) calls :meth:`TFBuffer.clear`, locked too. The start
+    of the measure is written under a lock by start, stop, the jump callback and the first
+    callback after a start before the first ``/clock``. A bad
     transform in a message is rejected by the buffer with a warning; the rest of the message
     is still used.
     """
@@ -115,7 +118,9 @@ class TFListener:
         now = self._now()
         if jump.clock_change == ClockChange.ROS_TIME_ACTIVATED:
             reason = "the clock switched to simulated time"
-            # Transforms stamped on the system time, still queued, are refused.
+            # Transforms stamped on the system time, still queued, are refused until the
+            # simulated clock gets there (at once when it follows the system time: the first
+            # transform served ends the refusal).
             refuse_after = time.time() - self.buffer.cache_time
         elif jump.clock_change == ClockChange.ROS_TIME_DEACTIVATED:
             reason = "the clock switched to the system time"
@@ -140,6 +145,9 @@ class TFListener:
         return self._node.get_clock().now().nanoseconds * 1e-9
 
     def _on_tf(self, msg: Any) -> None:
+        refusing_after = self.buffer.refusing_after
+        if refusing_after is not None and self._now() >= refusing_after:
+            self.buffer.end_refusal()  # the clock got past the old time line's start
         self._store(msg, "tf", False)
         since = self._age_since
         if since is None:
@@ -152,7 +160,12 @@ class TFListener:
                 if since <= 0.0:  # started before the first /clock: from the first reading
                     if now <= 0.0:
                         return
-                    self._age_since = since = now
+                    with self._age_lock:  # unless stopped or restarted meanwhile
+                        if self._age_since is not None and self._age_since <= 0.0:
+                            self._age_since = now
+                        since = self._age_since
+                    if since is None:
+                        return
                 stamp = stamp_to_seconds(ts.header.stamp)
                 # Not counted: stamped before the start, or ahead of the clock by more than
                 # a second (another time line: a transform queued across a clock jump).
