@@ -109,29 +109,37 @@ def test_a_nan_transform_on_the_wire_is_rejected_by_the_listener(ros_local, capl
     assert "'odom' -> 'laser'" in caplog.text
 
 
+def _simulated_listener(ros, name: str):
+    """A listener on simulated time and a simulator node that publishes ``/clock``, both
+    connected: ``(listener_node, simulator, publish_clock(seconds), buffer, listener)``."""
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+
+    listener_node = ros.create_node(
+        f"{name}_listener", parameter_overrides=[Parameter("use_sim_time", value=True)]
+    )
+    simulator = ros.create_node(f"{name}_clock")
+    clock_pub = simulator.create_publisher(Clock, "/clock", 10)
+    buffer = TFBuffer()
+    listener = TFListener(listener_node, buffer)
+
+    def publish_clock(seconds: float) -> None:
+        msg = Clock()
+        msg.clock.sec, msg.clock.nanosec = int(seconds), round((seconds % 1.0) * 1e9)
+        clock_pub.publish(msg)
+
+    assert ros.spin_until(lambda: clock_pub.get_subscription_count() > 0)
+    assert ros.spin_until(lambda: simulator.count_subscribers("tf") > 0)
+    return listener_node, simulator, publish_clock, buffer, listener
+
+
 def test_time_jumping_back_clears_the_buffer_so_the_new_run_is_used(ros_local):
     """A simulator restarted under a running system: its clock goes back to zero. Without the
     clear, the old run's transforms (stamped up to 60 s) would be the newest for the cache
     window and every new one, stamped from 0 s, refused as too old."""
-    from rclpy.parameter import Parameter
-    from rosgraph_msgs.msg import Clock
-
-    listener_node = ros_local.create_node(
-        "sim_listener", parameter_overrides=[Parameter("use_sim_time", value=True)]
-    )
-    clock_node = ros_local.create_node("sim_clock")
-    clock_pub = clock_node.create_publisher(Clock, "/clock", 10)
-    buffer = TFBuffer()
-    listener = TFListener(listener_node, buffer)
+    listener_node, clock_node, publish_clock, buffer, listener = _simulated_listener(
+        ros_local, "sim")
     dynamic = TFBroadcaster(clock_node)
-
-    def publish_clock(seconds: float) -> None:
-        msg = Clock()
-        msg.clock.sec = int(seconds)
-        clock_pub.publish(msg)
-
-    assert ros_local.spin_until(lambda: clock_pub.get_subscription_count() > 0)
-    assert ros_local.spin_until(lambda: clock_node.count_subscribers("tf") > 0)
     publish_clock(60.0)
     assert ros_local.spin_until(lambda: listener_node.get_clock().now().nanoseconds == 60e9)
     dynamic.send_transform(_ts("odom", "base_link", 60.0, 5.0))
@@ -151,22 +159,11 @@ def test_a_transform_of_the_old_time_line_served_after_the_jump_back_is_refused(
     the listener looks: ``/clock`` keeps only its newest message (the jump comes first), ``tf``
     keeps both. The old run's transform, served after the clear, is refused; stored, it locked
     the buffer on the old pose (every transform of the new run older than the window)."""
-    from rclpy.parameter import Parameter
-    from rosgraph_msgs.msg import Clock
-
-    listener_node = ros_local.create_node(
-        "late_listener", parameter_overrides=[Parameter("use_sim_time", value=True)]
-    )
-    simulator = ros_local.create_node("late_sim")
-    clock_pub = simulator.create_publisher(Clock, "/clock", 10)
-    buffer = TFBuffer()
-    listener = TFListener(listener_node, buffer)
+    _, simulator, publish_clock, buffer, listener = _simulated_listener(ros_local, "late")
     dynamic = TFBroadcaster(simulator)
 
     def tick(seconds: float, x: float) -> None:
-        msg = Clock()
-        msg.clock.sec, msg.clock.nanosec = int(seconds), round((seconds % 1.0) * 1e9)
-        clock_pub.publish(msg)
+        publish_clock(seconds)
         dynamic.send_transform(_ts("odom", "base_link", seconds, x))
 
     def newest() -> float:
@@ -175,8 +172,6 @@ def test_a_transform_of_the_old_time_line_served_after_the_jump_back_is_refused(
         except LookupError:
             return math.nan
 
-    assert ros_local.spin_until(lambda: clock_pub.get_subscription_count() > 0)
-    assert ros_local.spin_until(lambda: simulator.count_subscribers("tf") > 0)
     tick(60.0, 5.0)
     assert ros_local.spin_until(lambda: newest() == 60.0)
     tick(60.05, 5.0)  # the old run's last tick ...
