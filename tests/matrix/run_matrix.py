@@ -303,9 +303,11 @@ def main(argv: list[str]) -> int:
         "every computation takes twice as long in simulated time. A row that fails so is run "
         "again at x1 before it is looked into.",
         "",
-        f"- date: {started:%Y-%m-%d %H:%M} UTC (rows of earlier parts come from {results_path.name}"
-        f"); Python {platform.python_version()}; speed-up x{args.speed_up:g}; "
-        f"{args.jobs} run(s) at a time",
+        (f"- date: {started:%Y-%m-%d %H:%M} UTC, written from {results_path.name} (nothing run)"
+         if args.report else
+         f"- date: {started:%Y-%m-%d %H:%M} UTC (rows of earlier parts come from "
+         f"{results_path.name}); Python {platform.python_version()}; speed-up "
+         f"x{args.speed_up:g}; {args.jobs} run(s) at a time"),
         "- this run: "
         + ("the covering slice only (`--slice`)" if args.slice else "every combination")
         + (f" whose name contains {args.only}" if args.only else "")
