@@ -7,7 +7,7 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --speed-up the simulation's speed (x real time; EasyNav's loops keep their wall-clock rates,
              so its RT cycles per simulated second drop by as much). On a 2-core machine one
              mission at x2 ran at x1.9-2.0 with the same verdict and figures as at x1 (the
-             campus with MPPI and with VFF): the matrix there runs at x2, one at a time
+             campus with MPPI and with VFF): `make matrix` runs it at x2, one at a time
   --jobs N   N missions at once, each in a process of its own (a mission takes about a core
              at x1: N above the number of cores slows every run and can fail them)
   --results  where each finished run is kept, one JSON line per run (default
