@@ -183,13 +183,18 @@ def test_unreachable_goal_gives_an_empty_path_and_a_warning(cls, params):
 
 @pytest.mark.parametrize(("cls", "params"), PLANNERS)
 def test_goal_off_the_map_or_on_the_hill_is_named(cls, params):
+    # Off the map: rejected (the goal client gets the reason, NAVIGATION_FAILED); on a hill too
+    # steep: no path now, the recovery system decides.
     planner = make_planner(cls, params)
     nav_state = state_with(ridge_world(), (1.0, 1.0), (9.0, 1.0, 0.0))
     planner.update(nav_state)
-    assert "off the gridmap" in nav_state.get("diagnostics.path", DiagnosticStatus).message
+    reason = "goal (9.00, 1.00) is off the gridmap (x 0..8, y 0..6)"
+    assert nav_state.get("diagnostics.path", DiagnosticStatus).message == reason
+    assert planner.take_goal_rejection() == reason
     nav_state = state_with(ridge_world(), (1.0, 1.0), (2.3, 2.3, 0.0))
     planner.update(nav_state)
     assert "steeper than 30 deg" in nav_state.get("diagnostics.path", DiagnosticStatus).message
+    assert planner.take_goal_rejection() is None
 
 
 def test_rrtstar_is_deterministic_for_a_seed():

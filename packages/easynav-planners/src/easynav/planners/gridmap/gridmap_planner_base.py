@@ -30,8 +30,10 @@ class GridMapPlannerBase(PathPlannerBase):
 
     NavState: reads ``goals`` (plans to the first; in the map frame), ``robot_pose``, ``map``;
     writes ``path`` and ``diagnostics.path`` as every planner (:class:`PathPlannerBase`). A goal
-    or a robot off the gridmap, or a goal :meth:`plan` cannot reach, gives an empty path and a
-    throttled warning.
+    off the gridmap can never be reached: it is rejected (:meth:`reject_goal`: planner_node
+    aborts the mission naming it and the map's extent). A robot off the gridmap, or a goal
+    :meth:`plan` cannot reach, gives an empty path and a throttled warning (the recovery system
+    decides).
 
     Thread contract: ``initialize`` in the configuring thread, ``update`` in the non-RT thread.
     ``update`` does not raise for goals it cannot reach; it reports them.
@@ -57,6 +59,14 @@ class GridMapPlannerBase(PathPlannerBase):
                 f"{grid.origin_y + h * grid.resolution:g})"
             )
         return None
+
+    def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,
+                            goal_text: str) -> str | None:
+        """Off the gridmap in NavState (None without one: :meth:`plan_to` says so)."""
+        grid = nav_state.get(GRIDMAP) if nav_state.has(GRIDMAP) else None
+        if not isinstance(grid, GridMap):
+            return None
+        return self.goal_problem(grid, (gx, gy), "goal")
 
     def plan_to(self, nav_state: NavState, robot: Odometry, goal: tuple[float, float, float],
                 goal_text: str, map_frame: str) -> None:
