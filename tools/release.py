@@ -237,6 +237,20 @@ def sibling_folder(pkg: Package, req: Requirement, siblings: str, work: Path) ->
     return target / pkg.folder.relative_to(ROOT)
 
 
+def source_copy(folder: Path, into: Path) -> Path:
+    """A copy of the package source ``folder`` under ``into``, without what a build leaves in
+    it (its ``build/``, ``dist/``, ``*.egg-info`` and bytecode); the copy's path."""
+
+    def left_by_a_build(directory: str, names: list[str]) -> set[str]:
+        top = Path(directory) == folder
+        return {name for name in names if name == "__pycache__"
+                or (top and (name in ("build", "dist") or name.endswith(".egg-info")))}
+
+    target = into / folder.name
+    shutil.copytree(folder, target, ignore=left_by_a_build)
+    return target
+
+
 def closure(
     packages: dict[str, Package], names: list[str]
 ) -> list[tuple[Package, Requirement | None]]:
@@ -283,6 +297,10 @@ def isolated(
         wheels = work / "wheels"
         for pkg, req in closure(packages, names):
             folder = pkg.folder if req is None else sibling_folder(pkg, req, siblings, work)
+            if folder == pkg.folder:
+                # Built from a copy: setuptools builds in the source folder (build/, egg-info),
+                # and the isolated installs run at once; two builds in one folder collide.
+                folder = source_copy(pkg.folder, work / "sources")
             # The message package has compiled parts: built by the target Python, in a build
             # environment of its own unless that Python is this one.
             builder = sys.executable

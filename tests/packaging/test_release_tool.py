@@ -82,3 +82,41 @@ def test_the_lowest_sibling_is_the_range_lower_bound():
     req = next(r for r in packages["easynav-planners"].requirements if r.name == "easynav-core")
     assert release.lower_bound(req.specifier) <= core.version
     assert release.commit_with_version(core, core.version) is not None
+
+
+def test_the_isolated_installs_build_no_package_in_its_source_folder(monkeypatch):
+    # The two isolated installs of the suite run at once: building the message package in its
+    # own folder twice at the same time collided on its build/ (a CI run failed so).
+    built = []
+
+    class Stop(Exception):
+        pass
+
+    def record(folder, out, python=sys.executable):
+        built.append(folder)
+        return []
+
+    def stop_at_the_venv(cmd, **kwargs):
+        raise Stop
+
+    monkeypatch.setattr(release, "build_folder", record)
+    monkeypatch.setattr(release, "run", stop_at_the_venv)
+    monkeypatch.setattr(release, "same_python", lambda a, b: True)
+    packages = release.load_packages()
+    with pytest.raises(Stop):
+        release.isolated(packages, ["easynav-planners"], sys.executable, "highest", [])
+    assert "easynav-interfaces" in {folder.name for folder in built}
+    assert built and not any(folder.is_relative_to(REPO) for folder in built)
+
+
+def test_a_source_copy_leaves_out_what_a_build_left(tmp_path):
+    folder = tmp_path / "easynav-x"
+    for path in ("pyproject.toml", "src/easynav/x/__init__.py", "src/easynav/x/build/keep.py",
+                 "build/lib/old.py", "dist/old.whl", "easynav_x.egg-info/PKG-INFO",
+                 "src/easynav/x/__pycache__/m.pyc"):
+        (folder / path).parent.mkdir(parents=True, exist_ok=True)
+        (folder / path).write_text("")
+    copy = release.source_copy(folder, tmp_path / "copies")
+    assert copy == tmp_path / "copies" / "easynav-x"
+    assert sorted(str(p.relative_to(copy)) for p in copy.rglob("*") if p.is_file()) == [
+        "pyproject.toml", "src/easynav/x/__init__.py", "src/easynav/x/build/keep.py"]
