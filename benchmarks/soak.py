@@ -361,7 +361,7 @@ def main() -> int:
         map_yaml=description.map_server_yaml(run_dir),
         robot_radius=description.robot.radius if description.robot.declared else None,
         robot_height=description.robot.height,
-        terrain_file=description.terrain_path.resolve() if description.terrain_path else None,
+        elevation_file=description.elevation_map(run_dir),
     )
     domain = reserve_domain(f"soak/{os.getpid()}")  # held until the soak exits
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain),

@@ -23,7 +23,12 @@ from easynav.playground.sim import (
     World,
 )
 from easynav.playground.uneven_world import uneven_elevation, write_uneven_world
-from easynav.playground.world_description import WORLDS_DIR, WorldDescription, load_waypoints
+from easynav.playground.world_description import (
+    WALL_ELEVATION,
+    WORLDS_DIR,
+    WorldDescription,
+    load_waypoints,
+)
 
 RES = 0.1
 
@@ -213,6 +218,41 @@ def test_uneven_world_straight_legs_cross_steep_ground_and_astar_goes_round():
     assert blocked_legs >= 3  # start -> 1 and 4 -> 5 (the rock), 1 -> 2 (the bank)
 
 
+def test_a_flat_worlds_elevation_map_raises_its_walls_and_astar_goes_round(tmp_path):
+    # The GridMap stack in a flat world (the campus, with GNSS) gets the world's own map: the
+    # ground at 0 m, the buildings raised. It used to keep the params file's 12 x 8 m terrain
+    # and wait for ever for goals off it.
+    from easynav.maps.gridmap import load_gridmap
+    from easynav.planners.gridmap.terrain import cell_cost_factors
+    from easynav.planners.gridmap.terrain_astar import astar
+
+    description = WorldDescription.resolve("campus")
+    path = description.elevation_map(tmp_path)
+    assert path == (tmp_path / "world_elevation.npz").resolve()
+    grid = load_gridmap(path)
+    world = description.world
+    assert grid.shape == world.occupied.shape
+    assert (grid.resolution, grid.origin_x, grid.origin_y) == (
+        world.resolution, world.origin_x, world.origin_y)
+    assert np.array_equal(grid.elevation > 0.0, world.occupied)
+    assert grid.elevation.max() == WALL_ELEVATION
+    # West of the library (x 10..25, y 10..25) to east of it, on its middle line.
+    limit = math.radians(30.0)
+    start = tuple(int(v) for v in grid.world_to_cell(5.0, 17.0))
+    goal = tuple(int(v) for v in grid.world_to_cell(30.0, 17.0))
+    found = astar(grid, start, goal, limit, factors=cell_cost_factors(grid, limit, 0.5))
+    assert found is not None
+    cells = np.array(found[0])
+    assert not world.occupied[cells[:, 1], cells[:, 0]].any()
+    assert not (grid.layers["slope"][cells[:, 1], cells[:, 0]] > limit).any()
+    xs, ys = grid.cell_to_world(cells[:, 0], cells[:, 1])
+    beside = (xs > 10.0) & (xs < 25.0)
+    assert beside.any() and ((ys[beside] < 10.0) | (ys[beside] > 25.0)).all()
+    # A world with terrain: its own heights file.
+    uneven = WorldDescription.resolve("uneven")
+    assert uneven.elevation_map(tmp_path) == uneven.terrain_path.resolve()
+
+
 def test_the_demo_points_gridmap_managers_at_the_worlds_heights(tmp_path):
     source = tmp_path / "p.yaml"
     source.write_text(yaml.safe_dump({"maps_manager_node": {"ros__parameters": {
@@ -222,7 +262,7 @@ def test_the_demo_points_gridmap_managers_at_the_worlds_heights(tmp_path):
     }}}))
     heights = WORLDS_DIR / "maps" / "uneven_terrain.yaml"
     out = tmp_path / "out.yaml"
-    notes, _ = derive_params(source, tmp_path / "w.map", (0, 0, 0), out, terrain_file=heights)
+    notes, _ = derive_params(source, tmp_path / "w.map", (0, 0, 0), out, elevation_file=heights)
     gridmap = yaml.safe_load(out.read_text())["maps_manager_node"]["ros__parameters"]["gridmap"]
     assert gridmap["package"] == "" and gridmap["map_path_file"] == str(heights)
     assert any("elevation map" in n for n in notes)

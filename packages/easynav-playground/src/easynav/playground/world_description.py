@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from easynav.playground.robot_description import RobotDescription
@@ -20,6 +21,9 @@ from easynav.playground.sim.world import World
 WORLDS_DIR = Path(str(resources.files("easynav.playground") / "worlds"))
 #: Keys of a moving-obstacle entry that make it a :class:`ScriptedObstacle`.
 _SCRIPT_KEYS = {"start_time", "start_distance", "repeat", "pause"}
+#: Height (m) of a flat world's occupied cells in its elevation map (walls, buildings): the
+#: slope beside one is far above any a robot drives, so the GridMap planners keep off them.
+WALL_ELEVATION = 2.0
 #: Keys of a world's ``imu`` and ``gnss`` sections (playground parameters ``imu.*``, ``gnss.*``).
 _IMU_KEYS = {"rate", "gyro_noise", "gyro_bias", "accel_noise", "yaw_noise"}
 _GNSS_KEYS = {"rate", "noise", "jump_probability", "jump_distance", "outages"}
@@ -125,6 +129,24 @@ class WorldDescription:
         if self.terrain_path is None:
             return None
         return Terrain.load(self.terrain_path, self.max_climb_slope_deg)
+
+    def elevation_map(self, directory: Path) -> Path:
+        """The world's elevation map as a gridmap file (what GridmapMapsManager loads).
+        Absolute.
+
+        A world with terrain: its heights file. A flat world: the ground at 0 m with its
+        occupied cells raised :data:`WALL_ELEVATION` (what an elevation mapping of the world
+        would hold), on the map's own grid, written into ``directory`` as
+        ``world_elevation.npz``. Without it the GridMap stack would have no map of the world.
+        """
+        if self.terrain_path is not None:
+            return self.terrain_path.resolve()
+        from easynav.maps.gridmap import GridMap, save_gridmap_npz
+
+        world = self.world
+        elevation = np.where(world.occupied, WALL_ELEVATION, 0.0)
+        grid = GridMap(world.resolution, world.origin_x, world.origin_y, {"elevation": elevation})
+        return save_gridmap_npz(grid, Path(directory) / "world_elevation.npz").resolve()
 
     def sensor_parameter_defaults(self) -> dict[str, object]:
         """Playground parameter defaults of this world's IMU and GNSS (``imu.enabled``,

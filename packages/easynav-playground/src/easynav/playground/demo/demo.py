@@ -199,7 +199,7 @@ def _derive_run_params(description: WorldDescription, params_path: Path, run_pat
         map_yaml=description.map_server_yaml(run_path),
         robot_radius=robot.radius if robot.declared else None,
         robot_height=robot.height,
-        terrain_file=description.terrain_path.resolve() if description.terrain_path else None,
+        elevation_file=description.elevation_map(run_path),
     )
     notes = point_navmap_stack_at_world(
         derived, description, description.map_server_yaml(run_path), notes

@@ -188,9 +188,7 @@ def run_fleet_demo(
             map_yaml=description.map_server_yaml(run_path),
             robot_radius=robot.radius if robot.declared else None,
             robot_height=robot.height,
-            terrain_file=(
-                description.terrain_path.resolve() if description.terrain_path else None
-            ),
+            elevation_file=description.elevation_map(run_path),
         )
         for r in runs:
             r.path_topic = path_topics[r.name]

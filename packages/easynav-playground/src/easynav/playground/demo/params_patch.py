@@ -91,7 +91,7 @@ def derive_params(
     map_yaml: Path | None = None,
     robot_radius: float | None = None,
     robot_height: float | None = None,
-    terrain_file: Path | None = None,
+    elevation_file: Path | None = None,
 ) -> tuple[list[str], str | None]:
     """Write ``out_path``: the params file with the world's map and start pose, sim time on.
 
@@ -100,8 +100,8 @@ def derive_params(
       ``package`` emptied) when given;
     - every ``OctomapMapsManager`` / ``BonxaiMapsManager`` alias extrudes ``map_yaml``
       (``occmap_path_file``; its own map file and ``package`` emptied) when given;
-    - every ``GridmapMapsManager`` alias loads ``terrain_file`` (the world's elevation map;
-      ``package`` emptied) when given (a world with terrain);
+    - every ``GridmapMapsManager`` alias loads ``elevation_file`` (the world's elevation map:
+      :meth:`WorldDescription.elevation_map`; ``package`` emptied) when given;
     - every localizer alias with an ``initial_pose`` starts at ``start_pose``;
     - ``system_node.robot_geometry.radius`` is ``robot_radius`` and ``.height`` is
       ``robot_height`` when given (the world's robot);
@@ -154,11 +154,11 @@ def derive_params(
             _set(maps, f"{alias}.{VOXEL_MAPS_MANAGERS[plugin]}", "")
             _set(maps, f"{alias}.occmap_path_file", str(map_yaml))
             notes.append(f"maps_manager_node.{alias} extrudes the world's map {map_yaml}")
-        elif plugin in GRIDMAP_MAPS_MANAGERS and terrain_file is not None:
+        elif plugin in GRIDMAP_MAPS_MANAGERS and elevation_file is not None:
             _set(maps, f"{alias}.package", "")
-            _set(maps, f"{alias}.map_path_file", str(terrain_file))
+            _set(maps, f"{alias}.map_path_file", str(elevation_file))
             notes.append(
-                f"maps_manager_node.{alias} loads the world's elevation map {terrain_file}"
+                f"maps_manager_node.{alias} loads the world's elevation map {elevation_file}"
             )
         elif plugin in MAP_SERVER_MAPS_MANAGERS and map_yaml is not None:
             _set(maps, f"{alias}.package", "")
