@@ -182,18 +182,29 @@ def test_unreachable_goal_gives_an_empty_path_and_a_warning(cls, params):
 
 
 @pytest.mark.parametrize(("cls", "params"), PLANNERS)
-def test_goal_off_the_map_or_on_the_hill_is_named(cls, params):
-    # Off the map: rejected (the goal client gets the reason, NAVIGATION_FAILED); on a hill too
-    # steep: no path now, the recovery system decides.
+def test_goal_off_the_map_or_on_the_hill_is_rejected_naming_why(cls, params):
+    # Never reachable on this map: rejected (the goal client gets the reason, NAVIGATION_FAILED).
     planner = make_planner(cls, params)
-    nav_state = state_with(ridge_world(), (1.0, 1.0), (9.0, 1.0, 0.0))
+    for goal, reason in (
+        ((9.0, 1.0), "goal (9.00, 1.00) is off the gridmap (x 0..8, y 0..6)"),
+        ((2.3, 2.3), "goal (2.30, 2.30) is on terrain steeper than 30 deg or unknown"),
+    ):
+        nav_state = state_with(ridge_world(), (1.0, 1.0), (*goal, 0.0))
+        planner.update(nav_state)
+        assert nav_state.get("diagnostics.path", DiagnosticStatus).message == reason
+        assert planner.take_goal_rejection() == reason
+        assert len(nav_state.get("path", Path)) == 0
+
+
+@pytest.mark.parametrize(("cls", "params"), PLANNERS)
+def test_a_robot_off_the_map_gets_no_path_and_its_goal_is_kept(cls, params):
+    # Where the robot is may change (a localizer settling): the recovery system decides.
+    planner = make_planner(cls, params)
+    nav_state = state_with(ridge_world(), (20.0, 1.0), (1.0, 1.0, 0.0))
     planner.update(nav_state)
-    reason = "goal (9.00, 1.00) is off the gridmap (x 0..8, y 0..6)"
-    assert nav_state.get("diagnostics.path", DiagnosticStatus).message == reason
-    assert planner.take_goal_rejection() == reason
-    nav_state = state_with(ridge_world(), (1.0, 1.0), (2.3, 2.3, 0.0))
-    planner.update(nav_state)
-    assert "steeper than 30 deg" in nav_state.get("diagnostics.path", DiagnosticStatus).message
+    status = nav_state.get("diagnostics.path", DiagnosticStatus)
+    assert status.level == DiagnosticLevel.WARN
+    assert status.message == "robot (20.00, 1.00) is off the gridmap (x 0..8, y 0..6)"
     assert planner.take_goal_rejection() is None
 
 

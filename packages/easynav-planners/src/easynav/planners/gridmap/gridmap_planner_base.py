@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from easynav.core.nav_state import NavState
@@ -9,6 +11,7 @@ from easynav.core.nav_state_keys import GOALS, ROBOT_POSE
 from easynav.core.types import Header, Odometry, Path
 from easynav.maps.gridmap import GridMap
 from easynav.maps.gridmap.keys import GRIDMAP
+from easynav.planners.gridmap.terrain import cell_is_steep
 from easynav.planners.path_planner_base import PathPlannerBase
 from easynav.planners.plan_result import PlanResult
 
@@ -30,10 +33,10 @@ class GridMapPlannerBase(PathPlannerBase):
 
     NavState: reads ``goals`` (plans to the first; in the map frame), ``robot_pose``, ``map``;
     writes ``path`` and ``diagnostics.path`` as every planner (:class:`PathPlannerBase`). A goal
-    off the gridmap can never be reached: it is rejected (:meth:`reject_goal`: planner_node
-    aborts the mission naming it and the map's extent). A robot off the gridmap, or a goal
-    :meth:`plan` cannot reach, gives an empty path and a throttled warning (the recovery system
-    decides).
+    off the gridmap, or on terrain too steep or of unknown height, can never be reached: it is
+    rejected (:meth:`reject_goal`: planner_node aborts the mission naming it).
+    A robot off the gridmap, or a goal :meth:`plan` finds no way to, gives an empty path and
+    a throttled warning (the recovery system decides).
 
     Thread contract: ``initialize`` in the configuring thread, ``update`` in the non-RT thread.
     ``update`` does not raise for goals it cannot reach; it reports them.
@@ -62,11 +65,22 @@ class GridMapPlannerBase(PathPlannerBase):
 
     def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,
                             goal_text: str) -> str | None:
-        """Off the gridmap in NavState (None without one: :meth:`plan_to` says so)."""
+        """Off the gridmap in NavState, or on a cell steeper than ``max_allowed_slope_deg`` or
+        of unknown height: never reachable on this map (None without a GridMap: :meth:`plan_to`
+        says so). The gridmap counts as static, as the costmap stack's ``map.base``: a goal
+        sent before a map replaced through ``GridmapMapsManager.set_map`` reaches NavState is
+        judged on the old one."""
         grid = nav_state.get(GRIDMAP) if nav_state.has(GRIDMAP) else None
         if not isinstance(grid, GridMap):
             return None
-        return self.goal_problem(grid, (gx, gy), "goal")
+        problem = self.goal_problem(grid, (gx, gy), "goal")
+        if problem is not None:
+            return problem
+        limit_deg = self.params.max_allowed_slope_deg
+        ix, iy = (int(v) for v in grid.world_to_cell(gx, gy))
+        if cell_is_steep(grid, ix, iy, math.radians(limit_deg)):
+            return f"{goal_text} is on terrain steeper than {limit_deg:g} deg or unknown"
+        return None
 
     def plan_to(self, nav_state: NavState, robot: Odometry, goal: tuple[float, float, float],
                 goal_text: str, map_frame: str) -> None:

@@ -33,6 +33,13 @@ def steep_cells(grid: GridMap, max_slope_rad: float) -> np.ndarray:
         return ~np.isfinite(elevation) | ~np.isfinite(slope) | (slope > max_slope_rad + _EPS)
 
 
+def cell_is_steep(grid: GridMap, ix: int, iy: int, max_slope_rad: float) -> bool:
+    """:func:`steep_cells` for the one cell ``(ix, iy)`` (in bounds), without the whole map."""
+    z = float(grid.elevation[iy, ix])
+    slope = float(grid.layer("slope")[iy, ix])
+    return not (math.isfinite(z) and math.isfinite(slope)) or slope > max_slope_rad + _EPS
+
+
 def cell_cost_factors(grid: GridMap, max_slope_rad: float, margin: float) -> np.ndarray:
     """``[iy, ix]`` float: ``inf`` on steep cells, :data:`MARGIN_COST_FACTOR` within ``margin``
     metres of one (centre to centre), 1 elsewhere."""
