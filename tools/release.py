@@ -238,16 +238,23 @@ def sibling_folder(pkg: Package, req: Requirement, siblings: str, work: Path) ->
 
 
 def source_copy(folder: Path, into: Path) -> Path:
-    """A copy of the package source ``folder`` under ``into``, without what a build leaves in
-    it (its ``build/``, ``dist/``, ``*.egg-info`` and bytecode); the copy's path."""
-
-    def left_by_a_build(directory: str, names: list[str]) -> set[str]:
-        top = Path(directory) == folder
-        return {name for name in names if name == "__pycache__"
-                or (top and (name in ("build", "dist") or name.endswith(".egg-info")))}
-
+    """A copy of the package source ``folder`` under ``into``: the files git lists there
+    (tracked, and untracked ones git does not ignore), symlinks as the files they point to.
+    The build in the repository sees the same files (hatchling leaves out what ``.gitignore``
+    names; a copy outside the repository has no ``.gitignore`` above it), and none of what an
+    earlier build left (``build/``, ``*.egg-info``: ignored). Returns the copy's path."""
+    listed = subprocess.run(
+        ["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard", "--", "."],
+        cwd=folder, capture_output=True, check=True,
+    ).stdout
     target = into / folder.name
-    shutil.copytree(folder, target, ignore=left_by_a_build)
+    for name in filter(None, listed.split(b"\0")):
+        source = folder / os.fsdecode(name)
+        if not source.is_file():
+            continue  # deleted in the work tree, not yet in git
+        copy = target / os.fsdecode(name)
+        copy.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source, copy)
     return target
 
 

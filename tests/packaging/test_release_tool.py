@@ -109,14 +109,25 @@ def test_the_isolated_installs_build_no_package_in_its_source_folder(monkeypatch
     assert built and not any(folder.is_relative_to(REPO) for folder in built)
 
 
-def test_a_source_copy_leaves_out_what_a_build_left(tmp_path):
-    folder = tmp_path / "easynav-x"
-    for path in ("pyproject.toml", "src/easynav/x/__init__.py", "src/easynav/x/build/keep.py",
-                 "build/lib/old.py", "dist/old.whl", "easynav_x.egg-info/PKG-INFO",
-                 "src/easynav/x/__pycache__/m.pyc"):
+def test_a_source_copy_holds_what_git_lists(tmp_path):
+    # What a build in the repository sees: hatchling leaves out what .gitignore names, so the
+    # copy does too; an earlier build's build/ and egg-info are ignored.
+    import subprocess
+
+    subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
+    (tmp_path / ".gitignore").write_text("build/\ndist/\n*.egg-info/\n__pycache__/\n*.png\n")
+    folder = tmp_path / "packages" / "easynav-x"
+    for path in ("pyproject.toml", "src/easynav/x/__init__.py", "src/easynav/x/data/map.yaml",
+                 "src/easynav/x/picture.png", "build/lib/old.py", "dist/old.whl",
+                 "easynav_x.egg-info/PKG-INFO", "src/easynav/x/__pycache__/m.pyc", "gone.py"):
         (folder / path).parent.mkdir(parents=True, exist_ok=True)
         (folder / path).write_text("")
+    (folder / "src/easynav/x/link.yaml").symlink_to("data/map.yaml")
+    subprocess.run(["git", "add", "pyproject.toml", "gone.py"], cwd=folder, check=True)
+    (folder / "gone.py").unlink()
     copy = release.source_copy(folder, tmp_path / "copies")
     assert copy == tmp_path / "copies" / "easynav-x"
     assert sorted(str(p.relative_to(copy)) for p in copy.rglob("*") if p.is_file()) == [
-        "pyproject.toml", "src/easynav/x/__init__.py", "src/easynav/x/build/keep.py"]
+        "pyproject.toml", "src/easynav/x/__init__.py", "src/easynav/x/data/map.yaml",
+        "src/easynav/x/link.yaml"]
+    assert not (copy / "src/easynav/x/link.yaml").is_symlink()
