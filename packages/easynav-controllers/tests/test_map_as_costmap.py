@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from easynav.controllers.map_as_costmap import MapAsCostmap
-from easynav.core.types import FREE_SPACE, LETHAL_OBSTACLE, Costmap2D
+from easynav.core.types import FREE_SPACE, LETHAL_OBSTACLE, NO_INFORMATION, Costmap2D
 
 
 @dataclass
@@ -57,3 +57,42 @@ def test_the_simple_maps_managers_map_converts():
     costmap = MapAsCostmap()(grid)
     assert costmap.data.shape == (4, 5) and costmap.data[2, 1] == LETHAL_OBSTACLE
     assert int((costmap.data == LETHAL_OBSTACLE).sum()) == 1
+
+
+def test_the_gridmap_managers_map_converts_untraversable_cells_to_lethal_ones():
+    # The GridMap stack: MPPI, RPP and SeReST keep off what the elevation map says cannot be
+    # driven (on the campus with raised buildings, MPPI without obstacle terms cut a corner
+    # into one).
+    gridmap = pytest.importorskip("easynav.maps.gridmap")
+    elevation = np.zeros((6, 8))
+    elevation[2:4, 5:7] = 2.0  # a block 2 m high
+    elevation[0, 0] = np.nan  # unknown height
+    grid = gridmap.GridMap.from_elevation(elevation, 0.2, -1.0, 3.0, np.radians(30.0))
+    as_costmap = MapAsCostmap()
+    costmap = as_costmap(grid)
+    assert (costmap.resolution, costmap.origin_x, costmap.origin_y) == (0.2, -1.0, 3.0)
+    untraversable = grid.layer("traversability") <= 0.0
+    assert untraversable[2, 4] and untraversable[1, 5]  # the ring round the block is steep
+    assert (costmap.data[untraversable] == LETHAL_OBSTACLE).all()
+    unknown = ~np.isfinite(grid.layer("traversability"))
+    assert unknown[0, 0] and (costmap.data[unknown] == NO_INFORMATION).all()
+    assert (costmap.data[~untraversable & ~unknown] == FREE_SPACE).all()
+    assert costmap.data[3, 1] == FREE_SPACE
+    assert as_costmap(grid) is costmap  # the same map: no new conversion
+
+
+@dataclass
+class Layers:
+    layers: object
+    resolution: float = 0.1
+    origin_x: float = 0.0
+    origin_y: float = 0.0
+
+
+@pytest.mark.parametrize(
+    "value",
+    [Layers({}), Layers({"traversability": np.ones(4)}), Layers([np.ones((2, 2))]),
+     Layers({"traversability": np.ones((2, 2))}, resolution="fine")],
+)
+def test_layers_without_a_2d_traversability_give_no_obstacle_terms(value):
+    assert MapAsCostmap()(value) is None

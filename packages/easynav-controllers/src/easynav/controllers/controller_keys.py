@@ -13,7 +13,8 @@ MAP = NavStateKey(
     "map",
     "Costmap2D",
     "the dynamic costmap (costmap maps manager), or the simple maps manager's SimpleMap (its "
-    "occupied cells are lethal obstacles).",
+    "occupied cells are lethal obstacles), or the GridmapMapsManager's GridMap (its "
+    "untraversable cells are lethal obstacles).",
 )
 
 GOAL_TOLERANCE_POSITION = NavStateKey(

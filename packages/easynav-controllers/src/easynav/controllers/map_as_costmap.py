@@ -2,18 +2,27 @@
 
 from __future__ import annotations
 
-from easynav.core.types import Costmap2D
+import numpy as np
+
+from easynav.core.types import FREE_SPACE, LETHAL_OBSTACLE, NO_INFORMATION, Costmap2D
 
 
 class MapAsCostmap:
     """Reads NavState ``map`` as a :class:`Costmap2D`, whatever the maps manager wrote there.
 
-    A Costmap2D is returned as it is. A boolean occupancy grid (``cells``, ``(height, width)``,
-    with ``resolution``, ``origin_x``, ``origin_y``: the simple maps manager's SimpleMap) becomes
-    a costmap of lethal and free cells, converted once per map object (the maps managers write a
-    new one on every update and never change one in place). Anything else is None: no obstacle
-    terms. The conversion has no inflation: the cost-graded terms (MPPI's CostCritic) see lethal
-    and free cells only.
+    - A Costmap2D is returned as it is.
+    - A boolean occupancy grid (``cells``, ``(height, width)``, with ``resolution``,
+      ``origin_x``, ``origin_y``: the simple maps manager's SimpleMap) becomes a costmap of
+      lethal and free cells.
+    - An elevation map with a ``traversability`` layer (``layers``, with ``resolution``,
+      ``origin_x``, ``origin_y``: the GridmapMapsManager's GridMap) becomes a costmap whose
+      untraversable cells (traversability 0: a slope at or above the maps manager's
+      ``max_traversable_slope_deg``, walls of a flat world among them) are lethal, unknown ones
+      (NaN) no-information, the others free.
+
+    Each is converted once per map object (the maps managers write a new one when it changes
+    and never change one in place). Anything else is None: no obstacle terms. The conversions
+    have no inflation: the cost-graded terms (MPPI's CostCritic) see lethal and free cells only.
 
     Thread contract: one instance per controller, called from its RT thread.
     """
@@ -27,6 +36,27 @@ class MapAsCostmap:
             return value
         if value is self._source:
             return self._costmap
-        self._source, self._costmap = value, Costmap2D.from_occupancy_cells(value)
-        return self._costmap
+        costmap = Costmap2D.from_occupancy_cells(value)
+        if costmap is None:
+            costmap = traversability_as_costmap(value)
+        self._source, self._costmap = value, costmap
+        return costmap
 
+
+def traversability_as_costmap(grid: object) -> Costmap2D | None:
+    """A grid with a 2-D ``traversability`` layer (1 flat ... 0 untraversable, NaN unknown) as
+    a costmap: 0 lethal, NaN no-information, the rest free. None for anything else."""
+    layers = getattr(grid, "layers", None)
+    traversability = layers.get("traversability") if isinstance(layers, dict) else None
+    if not isinstance(traversability, np.ndarray) or traversability.ndim != 2:
+        return None
+    try:
+        resolution = float(grid.resolution)
+        origin_x, origin_y = float(grid.origin_x), float(grid.origin_y)
+    except (AttributeError, TypeError, ValueError):
+        return None
+    data = np.full(traversability.shape, FREE_SPACE, dtype=np.uint8)
+    with np.errstate(invalid="ignore"):
+        data[traversability <= 0.0] = LETHAL_OBSTACLE
+    data[~np.isfinite(traversability)] = NO_INFORMATION
+    return Costmap2D(data, resolution, origin_x, origin_y)
