@@ -144,6 +144,7 @@ class ScenarioRun:
             source, map_file, self.description.start_pose, self.params_path,
             map_yaml=self.description.map_server_yaml(self.run_dir),
             robot_radius=robot.radius if robot.declared else None, robot_height=robot.height,
+            elevation_file=self.description.elevation_map(self.run_dir),
         )
         self.record_path = self.run_dir / "ground_truth.json"
         env = dict(os.environ)

@@ -248,9 +248,29 @@ def test_a_flat_worlds_elevation_map_raises_its_walls_and_astar_goes_round(tmp_p
     xs, ys = grid.cell_to_world(cells[:, 0], cells[:, 1])
     beside = (xs > 10.0) & (xs < 25.0)
     assert beside.any() and ((ys[beside] < 10.0) | (ys[beside] > 25.0)).all()
-    # A world with terrain: its own heights file.
+    # A world with terrain: its own heights file. A world of two floors: none.
     uneven = WorldDescription.resolve("uneven")
     assert uneven.elevation_map(tmp_path) == uneven.terrain_path.resolve()
+    assert WorldDescription.resolve("two_floors").elevation_map(tmp_path) is None
+
+
+def test_the_demo_run_loads_the_flat_worlds_elevation_map(tmp_path):
+    from easynav.playground.demo.demo import _derive_run_params
+
+    source = tmp_path / "p.yaml"
+    source.write_text(yaml.safe_dump({"maps_manager_node": {"ros__parameters": {
+        "map_types": ["gridmap"],
+        "gridmap": {"plugin": "easynav_gridmap_maps_manager/GridmapMapsManager",
+                    "package": "easynav_maps", "map_path_file": "worlds/uneven_terrain.yaml"},
+    }}}))
+    run = tmp_path / "run"
+    run.mkdir()
+    derived, notes, _ = _derive_run_params(WorldDescription.resolve("campus"), source, run)
+    gridmap = yaml.safe_load(derived.read_text())["maps_manager_node"]["ros__parameters"]["gridmap"]
+    assert gridmap["package"] == ""
+    assert gridmap["map_path_file"] == str((run / "world_elevation.npz").resolve())
+    assert (run / "world_elevation.npz").is_file()
+    assert any("elevation map" in note for note in notes)
 
 
 def test_the_demo_points_gridmap_managers_at_the_worlds_heights(tmp_path):
@@ -266,6 +286,6 @@ def test_the_demo_points_gridmap_managers_at_the_worlds_heights(tmp_path):
     gridmap = yaml.safe_load(out.read_text())["maps_manager_node"]["ros__parameters"]["gridmap"]
     assert gridmap["package"] == "" and gridmap["map_path_file"] == str(heights)
     assert any("elevation map" in n for n in notes)
-    derive_params(source, tmp_path / "w.map", (0, 0, 0), out)  # a flat world: left as written
+    derive_params(source, tmp_path / "w.map", (0, 0, 0), out)  # no elevation map: as written
     gridmap = yaml.safe_load(out.read_text())["maps_manager_node"]["ros__parameters"]["gridmap"]
     assert gridmap["map_path_file"] == "worlds/uneven_terrain.yaml"

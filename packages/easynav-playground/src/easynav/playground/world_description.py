@@ -130,15 +130,18 @@ class WorldDescription:
             return None
         return Terrain.load(self.terrain_path, self.max_climb_slope_deg)
 
-    def elevation_map(self, directory: Path) -> Path:
-        """The world's elevation map as a gridmap file (what GridmapMapsManager loads).
-        Absolute.
+    def elevation_map(self, directory: Path) -> Path | None:
+        """The world's elevation map as a gridmap file (what GridmapMapsManager loads), absolute;
+        None for a world of several levels (one height per cell cannot hold two floors).
 
-        A world with terrain: its heights file. A flat world: the ground at 0 m with its
+        A world with terrain: its heights file as it is (the occupied cells of its map, such as
+        the ``uneven`` world's fence, are not added). A flat world: the ground at 0 m with its
         occupied cells raised :data:`WALL_ELEVATION` (what an elevation mapping of the world
         would hold), on the map's own grid, written into ``directory`` as
         ``world_elevation.npz``. Without it the GridMap stack would have no map of the world.
         """
+        if self.levels is not None:
+            return None
         if self.terrain_path is not None:
             return self.terrain_path.resolve()
         from easynav.maps.gridmap import GridMap, save_gridmap_npz
