@@ -6,6 +6,7 @@ planner must avoid, A* finds the way round)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -254,15 +255,21 @@ def test_a_flat_worlds_elevation_map_raises_its_walls_and_astar_goes_round(tmp_p
     assert WorldDescription.resolve("two_floors").elevation_map(tmp_path) is None
 
 
-def test_the_demo_run_loads_the_flat_worlds_elevation_map(tmp_path):
-    from easynav.playground.demo.demo import _derive_run_params
-
-    source = tmp_path / "p.yaml"
+def gridmap_params_file(directory) -> Path:
+    """A params file whose one maps manager is a GridmapMapsManager on the shipped terrain."""
+    source = directory / "p.yaml"
     source.write_text(yaml.safe_dump({"maps_manager_node": {"ros__parameters": {
         "map_types": ["gridmap"],
         "gridmap": {"plugin": "easynav_gridmap_maps_manager/GridmapMapsManager",
                     "package": "easynav_maps", "map_path_file": "worlds/uneven_terrain.yaml"},
     }}}))
+    return source
+
+
+def test_the_demo_run_loads_the_flat_worlds_elevation_map(tmp_path):
+    from easynav.playground.demo.demo import _derive_run_params
+
+    source = gridmap_params_file(tmp_path)
     run = tmp_path / "run"
     run.mkdir()
     derived, notes, _ = _derive_run_params(WorldDescription.resolve("campus"), source, run)
@@ -274,12 +281,7 @@ def test_the_demo_run_loads_the_flat_worlds_elevation_map(tmp_path):
 
 
 def test_the_demo_points_gridmap_managers_at_the_worlds_heights(tmp_path):
-    source = tmp_path / "p.yaml"
-    source.write_text(yaml.safe_dump({"maps_manager_node": {"ros__parameters": {
-        "map_types": ["gridmap"],
-        "gridmap": {"plugin": "easynav_gridmap_maps_manager/GridmapMapsManager",
-                    "package": "easynav_maps", "map_path_file": "worlds/uneven_terrain.yaml"},
-    }}}))
+    source = gridmap_params_file(tmp_path)
     heights = WORLDS_DIR / "maps" / "uneven_terrain.yaml"
     out = tmp_path / "out.yaml"
     notes, _ = derive_params(source, tmp_path / "w.map", (0, 0, 0), out, elevation_file=heights)

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
-from easynav.core.types import FREE_SPACE, LETHAL_OBSTACLE, NO_INFORMATION, Costmap2D
+from easynav.core.types import NO_INFORMATION, Costmap2D
 
 
 class MapAsCostmap:
@@ -50,13 +52,12 @@ def traversability_as_costmap(grid: object) -> Costmap2D | None:
     traversability = layers.get("traversability") if isinstance(layers, dict) else None
     if not isinstance(traversability, np.ndarray) or traversability.ndim != 2:
         return None
-    try:
-        resolution = float(grid.resolution)
-        origin_x, origin_y = float(grid.origin_x), float(grid.origin_y)
-    except (AttributeError, TypeError, ValueError):
-        return None
-    data = np.full(traversability.shape, FREE_SPACE, dtype=np.uint8)
     with np.errstate(invalid="ignore"):
-        data[traversability <= 0.0] = LETHAL_OBSTACLE
-    data[~np.isfinite(traversability)] = NO_INFORMATION
-    return Costmap2D(data, resolution, origin_x, origin_y)
+        untraversable = traversability <= 0.0
+    # The grid's geometry is checked as for an occupancy grid.
+    costmap = Costmap2D.from_occupancy_cells(SimpleNamespace(
+        cells=untraversable, **{key: getattr(grid, key, None)
+                                for key in ("resolution", "origin_x", "origin_y")}))
+    if costmap is not None:
+        costmap.data[~np.isfinite(traversability)] = NO_INFORMATION
+    return costmap
