@@ -216,6 +216,25 @@ def test_the_walls_of_an_occupancy_grid_map_are_obstacles():
     assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(near)
 
 
+def test_a_static_map_and_the_point_perceptions_count_both():
+    # A GridMap (the GridMap stack) holds no live obstacle: a nearer point ahead counts too.
+    gridmap = pytest.importorskip("easynav.maps.gridmap")
+    clock = Clock()
+    serest = make({}, LIMITS, clock)
+    elevation = np.zeros((50, 60))
+    elevation[20:30, 22:27] = 2.0  # a block from x = 1.2 m on, ahead of the robot at (0, 0)
+    nav_state = NavState()
+    nav_state.set("map", gridmap.GridMap.from_elevation(elevation, 0.1, -1.0, -2.5))
+    from_map = serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0)
+    assert from_map == pytest.approx(1.1, abs=0.01)  # its steep ring, a cell outside it
+    nav_state.set("scan", PointPerception(np.array([[0.8, 0.05, 0.2]]), "base_footprint",
+                                          clock.t))
+    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == from_map  # no points group
+    nav_state.set_group("points", ["a_grouped_sensor"])
+    assert serest.obstacle_distance(nav_state, 0.0, 0.0, 0.0) == pytest.approx(
+        math.hypot(0.8, 0.05))
+
+
 def test_closest_obstacle_distance_key_overrides_the_map():
     clock = Clock()
     serest = make({}, LIMITS, clock)

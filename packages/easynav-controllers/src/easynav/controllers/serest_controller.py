@@ -26,7 +26,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.nav_state_keys import CMD_VEL, PATH, ROBOT_POSE
 from easynav.core.plugins import ControllerMethodBase, Param
 from easynav.core.robot import RobotLimits
-from easynav.core.types import Header, Odometry, Path, Twist, TwistStamped
+from easynav.core.types import Costmap2D, Header, Odometry, Path, Twist, TwistStamped
 
 #: Below this speed (m/s) the robot counts as standing: its last command has no curvature.
 STANDSTILL = 0.01
@@ -60,15 +60,16 @@ class SerestController(ControllerMethodBase):
     applies each to its robot_limits field where the params file does not set that field.
 
     Obstacle distance: NavState ``closest_obstacle_distance`` (float) when present, taken as
-    it is; else the nearest lethal cell of the map in ``map`` (a Costmap2D, or a SimpleMap's
-    occupied cells: :class:`MapAsCostmap`) within ``dist_search_radius``; else, when a NavState
-    group named ``points`` exists (as the original), the nearest ungrouped point perception
-    within the square of ``dist_search_radius`` (0.3 m voxels, z <= 2 m, robot footprint
-    frame); else none (infinite). Cells and points count only when they are in the robot's way
-    (:class:`RobotWay`): within robot_geometry's ``radius`` of the line it drives on straight,
-    of the arc of its last command, or of the path ahead of it. The original counted every
-    direction, so a robot that came within ``d0_margin`` of an obstacle beside it stopped for
-    good.
+    it is; else the nearest lethal cell of the Costmap2D in ``map`` within
+    ``dist_search_radius``. A static map there (a SimpleMap's occupied cells, a GridMap's
+    untraversable ones: :class:`MapAsCostmap`) holds no live obstacle: the nearer of its cells
+    and, when a NavState group named ``points`` exists (as the original), the nearest ungrouped
+    point perception within the square of ``dist_search_radius`` (0.3 m voxels, z <= 2 m, robot
+    footprint frame); neither: none (infinite). Cells and points count only when they are in
+    the robot's way (:class:`RobotWay`): within robot_geometry's ``radius`` of the line it
+    drives on straight, of the arc of its last command, or of the path ahead of it. The
+    original counted every direction, so a robot that came within ``d0_margin`` of an obstacle
+    beside it stopped for good.
 
     NavState: reads ``path``, ``robot_pose``, ``map`` (required, as in the original: absent, the
     command is zero), ``closest_obstacle_distance``, ``goal_tolerance.position|yaw`` (preferred
@@ -189,11 +190,16 @@ class SerestController(ControllerMethodBase):
                 return float(value)
         radius = self.params.dist_search_radius
         way = self.robot_way(x, y, yaw)
-        costmap = self._map_as_costmap(nav_state.get(MAP))
+        value = nav_state.get(MAP)
+        costmap = self._map_as_costmap(value)
+        from_map = math.inf
         if costmap is not None:
-            return closest_lethal_distance(costmap, x, y, radius, way)
+            from_map = closest_lethal_distance(costmap, x, y, radius, way)
+            if isinstance(value, Costmap2D):
+                return from_map  # a costmap holds what the sensors see
+        # A SimpleMap or a GridMap is static: the point perceptions may see nearer obstacles.
         if "points" not in nav_state.groups():
-            return math.inf
+            return from_map
         frame = get_tf_buffer(self.context.namespace).get_tf_info().robot_footprint_frame
         points = (
             PointPerceptionsOps(nav_state.get_no_group(PointPerception), logger=self.logger)
@@ -208,7 +214,7 @@ class SerestController(ControllerMethodBase):
         dx = c * points[:, 0] - s * points[:, 1]
         dy = s * points[:, 0] + c * points[:, 1]
         # A point stands for its voxel (the first point of it is kept): half its diagonal.
-        return nearest_distance(dx, dy, way, slack=POINTS_VOXEL * math.sqrt(0.5))
+        return min(from_map, nearest_distance(dx, dy, way, slack=POINTS_VOXEL * math.sqrt(0.5)))
 
     def _stop(self, nav_state: NavState, now: float, state: str) -> None:
         self.tracker.reset()
