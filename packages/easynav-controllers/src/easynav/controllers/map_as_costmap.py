@@ -19,8 +19,9 @@ class MapAsCostmap:
     - An elevation map with a ``traversability`` layer (``layers``, with ``resolution``,
       ``origin_x``, ``origin_y``: the GridmapMapsManager's GridMap) becomes a costmap whose
       untraversable cells (traversability 0: a slope at or above the maps manager's
-      ``max_traversable_slope_deg``, walls of a flat world among them) are lethal, unknown ones
-      (NaN) no-information, the others free.
+      ``max_traversable_slope_deg``; for a flat world's raised walls, the ring of cells just
+      inside and outside each wall, the wall's inside being flat) are lethal, unknown ones
+      (NaN; off the map is unknown too) no-information, the others free.
 
     Each is converted once per map object (the maps managers write a new one when it changes
     and never change one in place). Anything else is None: no obstacle terms. The conversions

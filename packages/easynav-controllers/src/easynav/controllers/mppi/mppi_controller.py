@@ -36,7 +36,7 @@ class MPPIController(ControllerMethodBase):
     NavState: reads ``navigation_state`` ("IDLE": zero command), ``path``, ``robot_pose``,
     ``goal_tolerance.position`` / ``goal_tolerance.yaw`` (else ``xy_goal_tolerance`` /
     ``yaw_goal_tolerance``), ``map`` (Costmap2D for the CostCritic and PathAlignCritic, or a
-    SimpleMap read through :class:`MapAsCostmap`; absent: no obstacle terms); writes
+    SimpleMap or GridMap read through :class:`MapAsCostmap`; absent: no obstacle terms); writes
     ``cmd_vel`` (a new stamp every cycle; zero without path or pose, at the goal and when idle).
 
     Thread contract: ``initialize`` in the configuring thread, ``update_rt`` in the RT thread.

@@ -38,7 +38,7 @@ class RegulatedPurePursuitController(ControllerMethodBase):
 
     NavState: reads ``navigation_state`` ("IDLE": zero command), ``path``, ``robot_pose``,
     ``goal_tolerance.position`` / ``goal_tolerance.yaw`` (else ``xy_goal_tolerance`` /
-    ``yaw_goal_tolerance``), ``map`` (Costmap2D, or a SimpleMap read through
+    ``yaw_goal_tolerance``), ``map`` (Costmap2D, or a SimpleMap or GridMap read through
     :class:`MapAsCostmap`, for obstacle regulation; absent: no obstacle regulation); writes
     ``cmd_vel`` (a new stamp every cycle, zero without path or pose, at the goal and when
     idle). Topics (relative, published only when subscribed): ``lookahead_point``,
