@@ -257,3 +257,79 @@ def test_shipped_uneven_world_plateau_only_by_the_ramp(cls, params):
     assert on_slope.any() and climb
     ys = np.array([p.y for p in path.poses])[on_slope]
     assert ((ys > 1.0) & (ys < 3.0)).all()  # climbed on the ramp only
+
+
+def _poses(nav_state):
+    return [(p.x, p.y, p.yaw) for p in nav_state.get("path", Path).poses]
+
+
+def _move_robot(nav_state, x, y):
+    nav_state.set("robot_pose",
+                  Odometry(Header(2.0, "map"), "base_footprint", Pose.from_xy_yaw(x, y, 0.0)))
+
+
+def test_rrtstar_keeps_its_path_while_the_robot_follows_it():
+    # A new random tree from every pose the robot passes would give a new path every cycle.
+    grid = ridge_world()
+    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
+    nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.0))
+    planner.update(nav_state)
+    first = _poses(nav_state)
+    assert len(first) > 10
+    # Along the path, and 0.4 m beside it (max_lateral_deviation 0.5): the same path.
+    x, y, yaw = first[len(first) // 2]
+    for robot in ((x, y), (x - 0.4 * math.sin(yaw), y + 0.4 * math.cos(yaw))):
+        _move_robot(nav_state, *robot)
+        planner.update(nav_state)
+        assert _poses(nav_state) == first
+    # 0.7 m beside it: planned again from where the robot is.
+    rx, ry = x - 0.7 * math.sin(yaw), y + 0.7 * math.cos(yaw)
+    _move_robot(nav_state, rx, ry)
+    planner.update(nav_state)
+    replanned = _poses(nav_state)
+    assert replanned != first
+    assert replanned[0][:2] == pytest.approx((rx, ry))
+    assert replanned[-1] == pytest.approx((7.0, 1.0, 0.0))
+
+
+def test_rrtstar_plans_again_for_a_new_goal_map_or_parameter():
+    grid = ridge_world()
+    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
+    nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.0))
+    planner.update(nav_state)
+    first = _poses(nav_state)
+    # The same goal with another yaw is another goal.
+    pose = PoseStamped(Header(1.0, "map"), Pose.from_xy_yaw(7.0, 1.0, 1.0))
+    nav_state.set("goals", Goals(Header(1.0, "map"), [pose]))
+    planner.update(nav_state)
+    assert _poses(nav_state)[-1] == pytest.approx((7.0, 1.0, 1.0))
+    # A new map (GridmapMapsManager.set_map), here with the gap closed: planned on it.
+    nav_state.set("map", ridge_world(gap=False))
+    planner.update(nav_state)
+    assert _poses(nav_state) == []
+    assert "unreachable" in nav_state.get("diagnostics.path", DiagnosticStatus).message
+    nav_state.set("map", grid)
+    planner.update(nav_state)
+    assert len(_poses(nav_state)) > 10
+    # A parameter changed at runtime: planned with it.
+    planner.apply_parameter("spacing", 0.1)
+    planner.update(nav_state)
+    gaps = np.hypot(*np.diff(np.array(_poses(nav_state))[:, :2], axis=0).T)
+    assert gaps.max() <= 0.1 + 1e-9 and len(_poses(nav_state)) > len(first)
+
+
+def test_distance_to_polyline_matches_a_dense_sampling():
+    from easynav.planners.gridmap.gridmap_rrtstar_planner import distance_to_polyline
+
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        points = rng.uniform(-3, 3, size=(int(rng.integers(1, 6)), 2))
+        xy = tuple(rng.uniform(-4, 4, size=2))
+        if len(points) == 1:
+            dense = points
+        else:
+            t = np.linspace(0.0, 1.0, 4001)[:, None]
+            pairs = zip(points[:-1], points[1:], strict=True)
+            dense = np.concatenate([a + t * (b - a) for a, b in pairs])
+        expected = np.hypot(*(dense - np.array(xy)).T).min()
+        assert distance_to_polyline(points, xy) == pytest.approx(expected, abs=2e-3)

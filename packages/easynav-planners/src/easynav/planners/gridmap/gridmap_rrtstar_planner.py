@@ -3,9 +3,16 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
+import numpy as np
+
+from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param
+from easynav.core.types import Header, Odometry, Path
 from easynav.maps.gridmap import GridMap
+from easynav.maps.gridmap.keys import GRIDMAP
 from easynav.planners.gridmap.gridmap_planner_base import GridMapPlannerBase, yaws_along
 from easynav.planners.gridmap.terrain import cell_cost_factors
 from easynav.planners.gridmap.terrain_astar import astar
@@ -17,6 +24,28 @@ from easynav.planners.gridmap.terrain_rrtstar import (
     shortcut,
 )
 from easynav.planners.plan_result import PlanResult
+
+
+def distance_to_polyline(points: np.ndarray, xy: tuple[float, float]) -> float:
+    """Distance from ``xy`` to the polyline through ``points`` (``(K, 2)``, K >= 1)."""
+    p = np.asarray(xy, dtype=float)
+    if len(points) == 1:
+        return float(np.hypot(*(points[0] - p)))
+    a, b = points[:-1], points[1:]
+    ab = b - a
+    length2 = np.einsum("ij,ij->i", ab, ab)
+    t = np.einsum("ij,ij->i", p - a, ab) / np.where(length2 > 0.0, length2, 1.0)
+    nearest = a + np.clip(t, 0.0, 1.0)[:, None] * ab
+    return float(np.hypot(*(nearest - p).T).min())
+
+
+@dataclass(frozen=True, slots=True)
+class _KeptPlan:
+    """A path and what it was planned for (kept while they still hold)."""
+
+    grid: GridMap
+    goal: tuple[float, float, float]
+    poses: np.ndarray
 
 
 class GridMapRRTStarPlanner(GridMapPlannerBase):
@@ -52,6 +81,43 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
         Param("seed", 0, "seed of the sampler (same seed, same path)"),
     )
 
+    def __init__(self) -> None:
+        super().__init__()
+        self._kept: _KeptPlan | None = None
+        self._planned: _KeptPlan | None = None
+
+    def forget_path(self) -> None:
+        """The next update plans afresh."""
+        self._kept = None
+
+    def on_parameter_changed(self, name: str, value: Any) -> None:
+        """Every parameter shapes the path: the next update plans afresh."""
+        self.forget_path()
+
+    def plan_to(self, nav_state: NavState, robot: Odometry, goal: tuple[float, float, float],
+                goal_text: str, map_frame: str) -> None:
+        """The kept path while it holds (see the class docstring), else a new plan."""
+        grid = nav_state.get(GRIDMAP) if nav_state.has(GRIDMAP) else None
+        kept = self._kept
+        if (
+            kept is not None
+            and grid is kept.grid
+            and goal == kept.goal
+            and distance_to_polyline(kept.poses[:, :2], (robot.pose.x, robot.pose.y))
+            <= self.params.max_lateral_deviation
+        ):
+            length = PlanResult(kept.poses).length
+            self.write_path(nav_state, Path.from_xy_yaw(kept.poses, Header(self.now(), map_frame)),
+                            f"path of {length:.2f} m to {goal_text}")
+            return
+        self.forget_path()
+        self._planned = None
+        super().plan_to(nav_state, robot, goal, goal_text, map_frame)
+        # plan() records what it found; kept only when the base class wrote it as the path.
+        if self._planned is not None and self._planned.grid is grid:
+            self._kept = self._planned
+        self._planned = None
+
     def plan(self, grid: GridMap, start: tuple[float, float],
              goal: tuple[float, float, float]) -> PlanResult:
         """RRT* from ``start`` to ``goal`` on ``grid`` (reads the parameters now)."""
@@ -81,4 +147,6 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
                                      f"(the goal is reachable: raise max_iters)")
         path = shortcut(segments, found[0], p.max_lateral_deviation)
         points = resample(path, p.spacing)
-        return PlanResult(yaws_along(points, goal[2], p.final_poses_with_goal_orientation))
+        poses = yaws_along(points, goal[2], p.final_poses_with_goal_orientation)
+        self._planned = _KeptPlan(grid, tuple(goal), poses)
+        return PlanResult(poses)
