@@ -23,7 +23,13 @@ from easynav.core.types import (
 from easynav.maps.gridmap import GridMap
 from easynav.planners.gridmap.gridmap_astar_planner import GridMapAStarPlanner
 from easynav.planners.gridmap.gridmap_rrtstar_planner import GridMapRRTStarPlanner
-from easynav.planners.gridmap.terrain import cell_cost_factors, slope_of_move, steep_cells
+from easynav.planners.gridmap.terrain import (
+    cell_cost_factors,
+    may_reach,
+    slope_of_move,
+    steep_cells,
+    terrain_regions,
+)
 from easynav.planners.gridmap.terrain_astar import astar, dijkstra_costs
 
 _namespaces = itertools.count()
@@ -60,6 +66,40 @@ def test_astar_cost_equals_dijkstra_on_random_terrain(seed, margin):
         assert cells[0] == start and cells[-1] == goal
         assert_cells_obey_the_rule(grid, cells, limit)
     assert 0 < np.isinf(reference).sum() < reference.size  # the rule did cut something
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_regions_never_call_a_reachable_goal_unreachable(seed):
+    # Checked against the Dijkstra from every start (steep starts too: the robot may be on one).
+    grid = random_terrain(seed)
+    limit = math.radians(LIMIT_DEG)
+    regions = terrain_regions(grid, limit)
+    h, w = grid.shape
+    ruled_out = 0
+    for start in itertools.product(range(0, w, 3), range(0, h, 3)):
+        reachable = np.isfinite(dijkstra_costs(grid, start, limit))
+        for gy, gx in itertools.product(range(h), range(w)):
+            if not may_reach(regions, start, (gx, gy)):
+                assert not reachable[gy, gx], (start, (gx, gy))
+                ruled_out += 1
+    assert ruled_out > 0  # and the regions do rule goals out
+
+
+def test_a_walled_off_goal_is_unreachable_without_a_search():
+    # A flat yard inside a ring 2 m high (a building on a flat world's elevation map).
+    z = np.zeros((60, 80))
+    z[10:50, 30:70] = 2.0
+    z[14:46, 34:66] = 0.0
+    grid = GridMap.from_elevation(z, 0.1)
+    regions = terrain_regions(grid, math.radians(LIMIT_DEG))
+    assert not may_reach(regions, (5, 5), (50, 30))
+    assert may_reach(regions, (5, 5), (75, 55))
+    assert may_reach(regions, (50, 30), (50, 31))
+    for cls, params in PLANNERS:
+        nav_state = state_with(grid, (0.5, 0.5), (5.0, 3.0, 0.0))
+        make_planner(cls, params).update(nav_state)
+        status = nav_state.get("diagnostics.path", DiagnosticStatus)
+        assert status.level == DiagnosticLevel.WARN and "unreachable" in status.message
 
 
 def assert_cells_obey_the_rule(grid, cells, limit):

@@ -9,7 +9,7 @@ import numpy as np
 from easynav.core.plugins import Param
 from easynav.maps.gridmap import GridMap
 from easynav.planners.gridmap.gridmap_planner_base import GridMapPlannerBase, yaws_along
-from easynav.planners.gridmap.terrain import cell_cost_factors
+from easynav.planners.gridmap.terrain import cell_cost_factors, may_reach, terrain_regions
 from easynav.planners.gridmap.terrain_astar import astar
 from easynav.planners.plan_result import PlanResult
 
@@ -22,8 +22,10 @@ class GridMapAStarPlanner(GridMapPlannerBase):
     nor is a move between neighbours whose centres' slope exceeds it (the original's rule);
     cells within ``robot_radius + clearance_distance`` of such a cell cost
     :data:`~easynav.planners.gridmap.terrain.MARGIN_COST_FACTOR` times more (the original
-    declared both parameters without using them). Path: the cell centres from the robot's cell
-    to the goal's, then the goal point, each pose heading to the next, the last at the goal yaw.
+    declared both parameters without using them). A goal in no region the robot's cell touches
+    (:func:`~easynav.planners.gridmap.terrain.may_reach`) is unreachable without a search.
+    Path: the cell centres from the robot's cell to the goal's, then the goal point, each pose
+    heading to the next, the last at the goal yaw.
     NavState and threads: :class:`GridMapPlannerBase`.
     """
 
@@ -46,7 +48,9 @@ class GridMapAStarPlanner(GridMapPlannerBase):
         if math.isinf(factors[gy, gx]):
             return PlanResult(reason=f"the goal is on terrain steeper than "
                                      f"{self.params.max_allowed_slope_deg:g} deg or unknown")
-        found = astar(grid, (sx, sy), (gx, gy), max_slope, factors=factors)
+        found = None
+        if may_reach(terrain_regions(grid, max_slope), (sx, sy), (gx, gy)):
+            found = astar(grid, (sx, sy), (gx, gy), max_slope, factors=factors)
         if found is None:
             return PlanResult(reason=f"unreachable without slopes above "
                                      f"{self.params.max_allowed_slope_deg:g} deg")

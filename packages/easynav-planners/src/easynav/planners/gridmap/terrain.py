@@ -55,6 +55,36 @@ def cell_cost_factors(grid: GridMap, max_slope_rad: float, margin: float) -> np.
     return factors
 
 
+def terrain_regions(grid: GridMap, max_slope_rad: float) -> np.ndarray:
+    """``[iy, ix]`` int32 labels: 0 on steep cells, else the region of the cell: the cells
+    8-connected to it through cells that are not steep.
+
+    A path never leaves its region except from its start cell (the move rule only removes
+    moves between such cells), so a goal outside every region the start touches is
+    unreachable: :func:`may_reach` tells in a few milliseconds what a search over every
+    reachable cell tells in seconds. Computed for the whole map (OpenCV's labelling; about
+    2 ms for 500 x 350 cells).
+    """
+    free = (~steep_cells(grid, max_slope_rad)).astype(np.uint8)
+    _, labels = cv2.connectedComponents(free, connectivity=8, ltype=cv2.CV_32S)
+    return labels
+
+
+def may_reach(regions: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -> bool:
+    """False when no path can join the cells ``start`` and ``goal`` (``(ix, iy)``, in bounds)
+    under the slope rule; True when one may (the search decides). ``regions``:
+    :func:`terrain_regions`. The start cell is always allowed, steep or not (the robot is
+    there): its path goes on into the regions of its neighbours."""
+    gx, gy = goal
+    target = regions[gy, gx]
+    if target == 0:
+        return start == goal
+    sx, sy = start
+    h, w = regions.shape
+    around = regions[max(sy - 1, 0):min(sy + 2, h), max(sx - 1, 0):min(sx + 2, w)]
+    return bool((around == target).any())
+
+
 def move_allowed(z_from: float, z_to: float, horizontal: float, max_slope_rad: float) -> bool:
     """True when the line between two points ``horizontal`` m apart is not steeper than the
     limit."""
