@@ -85,7 +85,7 @@ def test_regions_never_call_a_reachable_goal_unreachable(seed):
     assert ruled_out > 0  # and the regions do rule goals out
 
 
-def test_a_walled_off_goal_is_unreachable_without_a_search():
+def test_a_walled_off_goal_is_unreachable_without_a_search(monkeypatch):
     # A flat yard inside a ring 2 m high (a building on a flat world's elevation map).
     z = np.zeros((60, 80))
     z[10:50, 30:70] = 2.0
@@ -95,6 +95,14 @@ def test_a_walled_off_goal_is_unreachable_without_a_search():
     assert not may_reach(regions, (5, 5), (50, 30))
     assert may_reach(regions, (5, 5), (75, 55))
     assert may_reach(regions, (50, 30), (50, 31))
+
+    def no_search(*args, **kwargs):
+        raise AssertionError("searched")
+
+    from easynav.planners.gridmap import gridmap_astar_planner, gridmap_rrtstar_planner
+
+    monkeypatch.setattr(gridmap_astar_planner, "astar", no_search)
+    monkeypatch.setattr(gridmap_rrtstar_planner, "astar", no_search)
     for cls, params in PLANNERS:
         nav_state = state_with(grid, (0.5, 0.5), (5.0, 3.0, 0.0))
         make_planner(cls, params).update(nav_state)
@@ -373,3 +381,36 @@ def test_distance_to_polyline_matches_a_dense_sampling():
             dense = np.concatenate([a + t * (b - a) for a, b in pairs])
         expected = np.hypot(*(dense - np.array(xy)).T).min()
         assert distance_to_polyline(points, xy) == pytest.approx(expected, abs=2e-3)
+
+
+def test_rrtstar_drops_its_path_when_the_robot_leaves_the_map():
+    grid = ridge_world()
+    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
+    nav_state = state_with(grid, (0.3, 1.0), (7.0, 1.0, 0.0))
+    planner.update(nav_state)
+    assert len(_poses(nav_state)) > 10
+    _move_robot(nav_state, -0.2, 1.0)  # 0.5 m from the path's start, off the map
+    planner.update(nav_state)
+    assert _poses(nav_state) == []
+    status = nav_state.get("diagnostics.path", DiagnosticStatus)
+    assert status.message.startswith("robot (-0.20, 1.00) is off the gridmap")
+
+
+def test_rrtstar_does_not_keep_a_path_planned_before_a_parameter_change():
+    # The parameter thread changes spacing while the non-RT thread plans.
+    grid = ridge_world()
+    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
+    plan = planner.plan
+
+    def plan_meanwhile_changed(*args):
+        result = plan(*args)
+        planner.apply_parameter("spacing", 0.1)
+        return result
+
+    planner.plan = plan_meanwhile_changed
+    nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.0))
+    planner.update(nav_state)
+    planner.plan = plan
+    planner.update(nav_state)
+    gaps = np.hypot(*np.diff(np.array(_poses(nav_state))[:, :2], axis=0).T)
+    assert gaps.max() <= 0.1 + 1e-9

@@ -54,14 +54,27 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
     Parameters: :attr:`PARAMETERS`. Segments obey the slope rules of
     :mod:`~easynav.planners.gridmap.terrain_rrtstar`; cells within the robot's radius
     (``system_node.robot_geometry.radius``) of steep terrain cost more. Before sampling, the goal
-    is checked to be reachable at all (:func:`~easynav.planners.gridmap.terrain.may_reach`, then an
-    A* search over the same rules), so an unreachable
-    goal is reported without sampling ``max_iters`` times. The tree's path is shortened (each
-    shortcut no dearer and within ``max_lateral_deviation`` of the points it drops), resampled
-    every ``spacing`` m; the last ``final_poses_with_goal_orientation`` poses take the goal yaw.
-    ``kdtree_rebuild_interval`` is accepted for the original's files: nearest neighbours are
-    found here by an exact vectorised scan, which needs no tree. The same map, start, goal and
-    ``seed`` give the same path. NavState and threads: :class:`GridMapPlannerBase`.
+    is checked to be reachable at all (:func:`~easynav.planners.gridmap.terrain.may_reach`, then
+    an A* search over the same rules), so an unreachable goal is reported without sampling
+    ``max_iters`` times. The tree's path is shortened (each shortcut no dearer and within
+    ``max_lateral_deviation`` of the points it drops), resampled every ``spacing`` m; the last
+    ``final_poses_with_goal_orientation`` poses take the goal yaw. ``kdtree_rebuild_interval``
+    is accepted for the original's files: nearest neighbours are found here by an exact
+    vectorised scan, which needs no tree. The same map, start, goal and ``seed`` give the same
+    path.
+
+    A path is kept (written again each cycle, whole) while the goal is the same, the robot is
+    on the gridmap and within ``max_lateral_deviation`` of the path, and NavState ``map`` is
+    the gridmap it was planned on; a new goal, map or parameter value, a robot farther off or a
+    failed plan make the planner plan again from the robot's pose. A new random tree every
+    cycle would give a new path every cycle, and a controller chasing them dithers. The
+    original also kept its path, but trimmed the poses passed and replanned when fewer than 3
+    were left, and kept it for a goal moved less than ``goal_threshold``; any change of the goal
+    is a new goal here.
+
+    NavState: :class:`GridMapPlannerBase`. Thread contract: as :class:`GridMapPlannerBase`;
+    a parameter changed (parameter thread) while a plan runs (non-RT thread) discards that
+    plan's path once written: the next update plans with the new value.
     """
 
     PARAMETERS = (
@@ -86,10 +99,13 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
         super().__init__()
         self._kept: _KeptPlan | None = None
         self._planned: _KeptPlan | None = None
+        # Bumped by forget_path (from any thread): a plan that started before a bump is not kept.
+        self._generation = 0
 
     def forget_path(self) -> None:
         """The next update plans afresh."""
         self._kept = None
+        self._generation += 1
 
     def on_parameter_changed(self, name: str, value: Any) -> None:
         """Every parameter shapes the path: the next update plans afresh."""
@@ -100,11 +116,13 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
         """The kept path while it holds (see the class docstring), else a new plan."""
         grid = nav_state.get(GRIDMAP) if nav_state.has(GRIDMAP) else None
         kept = self._kept
+        robot_xy = (robot.pose.x, robot.pose.y)
         if (
             kept is not None
             and grid is kept.grid
             and goal == kept.goal
-            and distance_to_polyline(kept.poses[:, :2], (robot.pose.x, robot.pose.y))
+            and self.goal_problem(grid, robot_xy, "robot") is None
+            and distance_to_polyline(kept.poses[:, :2], robot_xy)
             <= self.params.max_lateral_deviation
         ):
             length = PlanResult(kept.poses).length
@@ -113,9 +131,12 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
             return
         self.forget_path()
         self._planned = None
+        generation = self._generation
         super().plan_to(nav_state, robot, goal, goal_text, map_frame)
-        # plan() records what it found; kept only when the base class wrote it as the path.
-        if self._planned is not None and self._planned.grid is grid:
+        # plan() records what it found; kept only when the base class wrote it as the path,
+        # and only if no parameter changed meanwhile.
+        if (self._planned is not None and self._planned.grid is grid
+                and generation == self._generation):
             self._kept = self._planned
         self._planned = None
 
