@@ -316,11 +316,15 @@ def _move_robot(nav_state, x, y):
                   Odometry(Header(2.0, "map"), "base_footprint", Pose.from_xy_yaw(x, y, 0.0)))
 
 
+def _rrtstar_on_the_ridge(start=(1.0, 1.0)):
+    """An RRT* planner and a NavState on :func:`ridge_world`, the goal at (7, 1)."""
+    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
+    return planner, state_with(ridge_world(), start, (7.0, 1.0, 0.0))
+
+
 def test_rrtstar_keeps_its_path_while_the_robot_follows_it():
     # A new random tree from every pose the robot passes would give a new path every cycle.
-    grid = ridge_world()
-    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
-    nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.0))
+    planner, nav_state = _rrtstar_on_the_ridge()
     planner.update(nav_state)
     first = _poses(nav_state)
     assert len(first) > 10
@@ -341,9 +345,8 @@ def test_rrtstar_keeps_its_path_while_the_robot_follows_it():
 
 
 def test_rrtstar_plans_again_for_a_new_goal_map_or_parameter():
-    grid = ridge_world()
-    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
-    nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.0))
+    planner, nav_state = _rrtstar_on_the_ridge()
+    grid = nav_state.get("map")
     planner.update(nav_state)
     first = _poses(nav_state)
     # The same goal with another yaw is another goal.
@@ -384,9 +387,7 @@ def test_distance_to_polyline_matches_a_dense_sampling():
 
 
 def test_rrtstar_drops_its_path_when_the_robot_leaves_the_map():
-    grid = ridge_world()
-    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
-    nav_state = state_with(grid, (0.3, 1.0), (7.0, 1.0, 0.0))
+    planner, nav_state = _rrtstar_on_the_ridge(start=(0.3, 1.0))
     planner.update(nav_state)
     assert len(_poses(nav_state)) > 10
     _move_robot(nav_state, -0.2, 1.0)  # 0.5 m from the path's start, off the map
@@ -398,8 +399,7 @@ def test_rrtstar_drops_its_path_when_the_robot_leaves_the_map():
 
 def test_rrtstar_does_not_keep_a_path_planned_before_a_parameter_change():
     # The parameter thread changes spacing while the non-RT thread plans.
-    grid = ridge_world()
-    planner = make_planner(GridMapRRTStarPlanner, {"seed": 5, "max_iters": 1500})
+    planner, nav_state = _rrtstar_on_the_ridge()
     plan = planner.plan
 
     def plan_meanwhile_changed(*args):
@@ -408,7 +408,6 @@ def test_rrtstar_does_not_keep_a_path_planned_before_a_parameter_change():
         return result
 
     planner.plan = plan_meanwhile_changed
-    nav_state = state_with(grid, (1.0, 1.0), (7.0, 1.0, 0.0))
     planner.update(nav_state)
     planner.plan = plan
     planner.update(nav_state)
