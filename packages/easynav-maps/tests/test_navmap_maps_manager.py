@@ -15,6 +15,7 @@ from easynav.core.nav_state import NavState
 from easynav.core.plugins import DictParameters, PluginConfigurationError, PluginContext
 from easynav.core.plugins.discovery import load_plugin_class
 from easynav.core.plugins.plugin_kinds import MAPS_MANAGER
+from easynav.core.robot import RobotGeometry
 from easynav.core.types import Header, Transform, TransformStamped
 from easynav.maps.navmap import NavMap
 from easynav.maps.navmap.inflation_filter import (
@@ -47,11 +48,12 @@ def room_yaml(tmp_path, size=40, resolution=0.1):
     return tmp_path / "room.yaml"
 
 
-def make_manager(params: dict) -> NavMapMapsManager:
+def make_manager(params: dict, geometry: RobotGeometry | None = None) -> NavMapMapsManager:
     context = PluginContext(
         parameters=DictParameters({f"navmap.{k}": v for k, v in params.items()}),
         namespace=f"navmap_test_{next(_namespaces)}",
         now=lambda: 100.0,
+        robot_geometry=lambda: geometry or RobotGeometry(),
     )
     manager = NavMapMapsManager()
     manager.initialize(context, "navmap")
@@ -326,6 +328,25 @@ def test_manager_with_both_filters(tmp_path):
     manager.update(nav_state)
     assert nav_state.get(MAP_NAVMAP).layer("inflated_obstacles")[
         navmap.locate_navcel((3.0, 3.0, 0))] > 0
+
+
+def test_inflation_takes_the_inscribed_radius_of_robot_geometry(tmp_path, caplog):
+    # The seed: a filter's own inscribed_radius is a deprecated copy; robot_geometry (here its
+    # radius, which the inscribed radius defaults to) takes precedence where it is set.
+    geometry = RobotGeometry(radius=0.4, inscribed_radius=0.4, user_set=frozenset({"radius"}))
+    for params, inscribed in (({"inflation.inscribed_radius": 0.1}, 0.4), ({}, 0.4)):
+        manager = make_manager({
+            "occmap_path_file": str(room_yaml(tmp_path)),
+            **filters(("obstacles", OBSTACLES), ("inflation", INFLATION)),
+            "inflation.inflation_radius": 0.6, **params,
+        }, geometry)
+        nav_state = NavState()
+        manager.update(nav_state)
+        navmap = nav_state.get(MAP_NAVMAP)
+        expected = _direct_inflation(navmap, navmap.layer("obstacles"), 0.6, 3.0, inscribed)
+        np.testing.assert_array_equal(navmap.layer("inflated_obstacles"), expected)
+    assert ("inflation.inscribed_radius is deprecated and ignored: "
+            "system_node.robot_geometry.inscribed_radius = 0.4 takes precedence") in caplog.text
 
 
 def test_inflation_without_obstacles_layer_leaves_the_map(tmp_path):

@@ -413,3 +413,26 @@ def test_rrtstar_does_not_keep_a_path_planned_before_a_parameter_change():
     planner.update(nav_state)
     gaps = np.hypot(*np.diff(np.array(_poses(nav_state))[:, :2], axis=0).T)
     assert gaps.max() <= 0.1 + 1e-9
+
+
+def test_astar_margin_takes_the_radius_of_robot_geometry(caplog):
+    # The seed: the planner's own robot_radius is a deprecated copy; robot_geometry takes
+    # precedence where it sets the radius.
+    from easynav.core.robot import RobotGeometry
+
+    def astar_planner(params, geometry):
+        planner = GridMapAStarPlanner()
+        planner.initialize(
+            PluginContext(parameters=DictParameters({f"p.{k}": v for k, v in params.items()}),
+                          namespace=f"gridmap_planner_test_{next(_namespaces)}",
+                          robot_geometry=lambda: geometry),
+            "p",
+        )
+        return planner
+
+    configured = RobotGeometry(radius=0.45, inscribed_radius=0.45, user_set=frozenset({"radius"}))
+    assert astar_planner({}, configured).robot_radius() == 0.45
+    assert astar_planner({"robot_radius": 0.2}, configured).robot_radius() == 0.45
+    assert "p.robot_radius is deprecated and ignored" in caplog.text
+    assert astar_planner({"robot_radius": 0.2}, RobotGeometry()).robot_radius() == 0.2
+    assert astar_planner({}, RobotGeometry()).robot_radius() == 0.3  # the original's default

@@ -80,30 +80,29 @@ def test_a_flat_world_converts_its_map_and_keeps_the_extrusion(tmp_path):
     assert wall_cloud_file(description, tmp_path) is None
 
 
-def test_the_navmap_inflation_keeps_the_worlds_robot_off_the_walls(tmp_path):
-    """A file written for a 0.2 m robot (inscribed 0.25) run on the campus (0.3 m robot): cost
-    253 reaches 0.3 m; a wider setting, and the home's 0.2 m robot, leave the file as it is."""
+def test_the_navmap_inflation_reaches_as_far_as_the_worlds_robot(tmp_path):
+    """A file written for a 0.2 m robot (inflation radius 0.2) run on the campus (0.3 m robot):
+    the inflation reaches 0.3 m (its cost 253 within the robot geometry's inscribed radius, the
+    world's robot); a wider setting, and the home's 0.2 m robot, leave the file as it is."""
     stack = yaml.safe_load(STACK)
     navmap = stack["maps_manager_node"]["ros__parameters"]["navmap"]
     navmap["filters"] = ["obstacles", "inflation", "wide"]
     filter_plugin = "easynav_navmap_maps_manager/NavMapMapsManager/"
     navmap["obstacles"] = {"plugin": filter_plugin + "ObstaclesFilter"}
-    navmap["inflation"] = {"plugin": filter_plugin + "InflationFilter", "inscribed_radius": 0.25}
-    navmap["wide"] = {"plugin": filter_plugin + "InflationFilter", "inscribed_radius": 0.4,
-                      "inflation_radius": 0.6}
-    for world, inscribed in (("campus", 0.3), ("home", 0.25)):
+    navmap["inflation"] = {"plugin": filter_plugin + "InflationFilter", "inflation_radius": 0.2}
+    navmap["wide"] = {"plugin": filter_plugin + "InflationFilter", "inflation_radius": 0.6}
+    for world, inflation in (("campus", 0.3), ("home", 0.2)):
         description = WorldDescription.resolve(world)
         out = tmp_path / f"{world}.yaml"
         out.write_text(yaml.safe_dump(stack))
         notes = point_navmap_stack_at_world(out, description, None, [])
         maps = yaml.safe_load(out.read_text())["maps_manager_node"]["ros__parameters"]
-        assert maps["navmap"]["inflation"]["inscribed_radius"] == inscribed
-        assert maps["navmap"]["inflation"].get("inflation_radius", 0.3) == 0.3
+        assert maps["navmap"]["inflation"]["inflation_radius"] == inflation
+        assert "inscribed_radius" not in maps["navmap"]["inflation"]
         assert maps["navmap"]["wide"] == navmap["wide"]
-        assert "inscribed_radius" not in maps["navmap"]["obstacles"]
-        changed = [n for n in notes if "inscribed_radius" in n]
+        changed = [n for n in notes if "inflation_radius" in n]
         assert changed == ([
-            "maps_manager_node.navmap.inflation inscribed_radius 0.25 -> 0.3: the world's "
+            "maps_manager_node.navmap.inflation inflation_radius 0.2 -> 0.3: the world's "
             "robot is 0.3 m"
         ] if world == "campus" else [])
 

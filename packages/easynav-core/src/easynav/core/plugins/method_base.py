@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar
 
 from easynav.core.plugins.declarations import Param, ParameterValueError, ParameterValues, Topic
@@ -73,6 +74,7 @@ class MethodBase(ParameterOwner):
         self.rt_rate_monitor: RateMonitor | None = None
         self.rate_monitor: RateMonitor | None = None
         self.params = ParameterValues()
+        self._geometry_warnings: set[str] = set()
 
     # -- declarations (see ParameterOwner) ----------------------------------------------------
     def validate_parameter(self, name: str, value: Any) -> Any:
@@ -175,6 +177,34 @@ class MethodBase(ParameterOwner):
     def get_robot_geometry(self) -> RobotGeometry:
         """The robot geometry configured in system_node (snapshot)."""
         return self.context.robot_geometry()
+
+    def geometry_or_deprecated(self, name: str, field: str,
+                               also_set_by: tuple[str, ...] = ()) -> float:
+        """``system_node.robot_geometry.<field>``, or this plugin's deprecated copy ``name``.
+
+        The copy (a parameter declared with a NaN default: unset) applies only where the params
+        file configures neither ``field`` nor a field it defaults to (``also_set_by``: the
+        inscribed radius defaults to the radius); robot_geometry takes precedence when both are
+        set, whatever its value (as in the original EasyNav). A set copy logs a warning, once per
+        message: deprecated, or deprecated and ignored.
+        """
+        geometry = self.get_robot_geometry()
+        value = float(getattr(geometry, field))
+        legacy = self.params[name]
+        if math.isnan(legacy):
+            return value
+        full = f"{self.plugin_name}.{name}"
+        if any(geometry.is_set(f) for f in (field, *also_set_by)):
+            message = (f"{full} is deprecated and ignored: system_node.robot_geometry.{field} = "
+                       f"{value:g} takes precedence")
+        else:
+            message = (f"{full} = {legacy:g} is deprecated: set "
+                       f"system_node.robot_geometry.{field} instead")
+            value = float(legacy)
+        if message not in self._geometry_warnings:
+            self._geometry_warnings.add(message)
+            self.logger.warning(message)
+        return value
 
     def get_tf_info(self) -> TFInfo:
         """The robot's frames configured in system_node (snapshot)."""

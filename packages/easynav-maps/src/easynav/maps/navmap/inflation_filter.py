@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import heapq
+import math
 
 import numpy as np
 
@@ -127,6 +128,12 @@ class InflationFilter(NavMapFilter):
     an ``obstacles`` layer (no ObstaclesFilter before it) the map is left as is, with a
     throttled error (the original logs "inflate_layer_u8() failed").
 
+    The inscribed radius is ``system_node.robot_geometry.inscribed_radius`` (which defaults to
+    ``robot_geometry.radius``; both 0.3 by default, the original filter's own default). The
+    filter's ``inscribed_radius`` is deprecated: set, it applies (with a warning) only where the
+    params file sets neither ``robot_geometry.inscribed_radius`` nor ``robot_geometry.radius``;
+    robot_geometry takes precedence otherwise.
+
     Thread contract: as :class:`NavMapFilter` (non-RT thread). Exceptions: configuration errors
     name the parameter.
     """
@@ -134,7 +141,9 @@ class InflationFilter(NavMapFilter):
     PARAMETERS = (
         Param("inflation_radius", 0.30, "distance up to which costs decay", "m", gt=0.0),
         Param("cost_scaling_factor", 3.0, "exponential decay rate of the cost", "1/m", gt=0.0),
-        Param("inscribed_radius", 0.30, "cost 253 within this distance", "m", ge=0.0),
+        Param("inscribed_radius", math.nan,
+              "deprecated: system_node.robot_geometry.inscribed_radius is used (unset here)",
+              "m", ge=0.0, allow_nan=True),
     )
     LAYER_NAME = "inflated_obstacles"
     SOURCE_LAYER = "obstacles"
@@ -154,4 +163,12 @@ class InflationFilter(NavMapFilter):
             return
         p = self.params
         inflate_layer(navmap, self.SOURCE_LAYER, self.LAYER_NAME, p.inflation_radius,
-                      p.cost_scaling_factor, p.inscribed_radius)
+                      p.cost_scaling_factor, self.inscribed_radius())
+
+    def on_initialize(self) -> None:
+        self.inscribed_radius()  # warn now about a deprecated setting, not at the first cycle
+
+    def inscribed_radius(self) -> float:
+        """The inscribed radius in use (m): robot_geometry's, or the deprecated parameter."""
+        return self.geometry_or_deprecated("inscribed_radius", "inscribed_radius",
+                                           also_set_by=("radius",))

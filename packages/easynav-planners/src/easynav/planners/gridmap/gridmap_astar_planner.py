@@ -20,28 +20,38 @@ class GridMapAStarPlanner(GridMapPlannerBase):
     Parameters: :attr:`PARAMETERS`. Cost: 3-D length (:mod:`terrain_astar`). Cells whose
     terrain slope exceeds ``max_allowed_slope_deg`` (or of unknown height) are never entered,
     nor is a move between neighbours whose centres' slope exceeds it (the original's rule);
-    cells within ``robot_radius + clearance_distance`` of such a cell cost
+    cells within the robot's radius plus ``clearance_distance`` of such a cell cost
     :data:`~easynav.planners.gridmap.terrain.MARGIN_COST_FACTOR` times more (the original
-    declared both parameters without using them). A goal in no region the robot's cell touches
-    (:func:`~easynav.planners.gridmap.terrain.may_reach`) is unreachable without a search.
+    declared ``robot_radius`` and ``clearance_distance`` without using them). The radius is
+    ``system_node.robot_geometry.radius``; ``robot_radius`` is deprecated: set, it applies (with
+    a warning) only where the params file does not set ``robot_geometry.radius``. A goal in no
+    region the robot's cell touches (:func:`~easynav.planners.gridmap.terrain.may_reach`) is
+    unreachable without a search.
     Path: the cell centres from the robot's cell to the goal's, then the goal point, each pose
     heading to the next, the last at the goal yaw.
     NavState and threads: :class:`GridMapPlannerBase`.
     """
 
     PARAMETERS = (
-        Param("robot_radius", 0.3, "robot radius kept from terrain above the slope limit", "m",
-              ge=0.0),
+        Param("robot_radius", math.nan, "deprecated: system_node robot_geometry.radius", "m",
+              ge=0.0, allow_nan=True),
         Param("clearance_distance", 0.2, "extra distance kept beyond robot_radius", "m", ge=0.0),
         Param("max_allowed_slope_deg", 30.0, "steepest slope the robot may drive", "deg",
               gt=0.0, lt=90.0),
     )
 
+    def configure_planner(self) -> None:
+        self.robot_radius()  # warn now about a deprecated setting, not at the first plan
+
+    def robot_radius(self) -> float:
+        """The robot's radius (m): robot_geometry's, or the deprecated ``robot_radius``."""
+        return self.geometry_or_deprecated("robot_radius", "radius")
+
     def plan(self, grid: GridMap, start: tuple[float, float],
              goal: tuple[float, float, float]) -> PlanResult:
         """A* from ``start`` to ``goal`` on ``grid`` (reads the parameters now)."""
         max_slope = math.radians(self.params.max_allowed_slope_deg)
-        margin = self.params.robot_radius + self.params.clearance_distance
+        margin = self.robot_radius() + self.params.clearance_distance
         factors = cell_cost_factors(grid, max_slope, margin)
         sx, sy = (int(v) for v in grid.world_to_cell(*start))
         gx, gy = (int(v) for v in grid.world_to_cell(goal[0], goal[1]))

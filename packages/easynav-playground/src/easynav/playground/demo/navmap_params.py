@@ -12,10 +12,10 @@ wrote, for the NavMap stack (issue #17):
   (``<world>.walls.ply`` beside the description, generated into the run directory by
   :mod:`easynav.playground.sim.wall_cloud` when the world ships none) instead of extruding the
   ground floor's 2D map;
-- every NavMap ``InflationFilter`` keeps cost 253 at least as far as the world's robot reaches:
-  its own ``inscribed_radius`` (not the robot geometry's, as in the original) is raised to the
-  robot's radius when smaller (a file written for a 0.2 m robot, run with the campus's 0.3 m
-  one, would let the planner pass 0.25 m from a wall), ``inflation_radius`` with it;
+- every NavMap ``InflationFilter`` inflates at least as far as the world's robot reaches: its
+  ``inflation_radius`` is raised to the robot's radius when smaller (cost 253 reaches the
+  inscribed radius, the robot geometry's, which the demo sets to the world's robot, only
+  within the inflation radius);
 - every localizer alias with an ``initial_pose`` gets ``initial_pose.z``, the start floor's
   height, when the world has levels and the alias declares that key (the NavMap AMCL).
 
@@ -35,8 +35,8 @@ from easynav.playground.sim.wall_cloud import wall_cloud_path, write_wall_cloud
 
 NAVMAP_MAPS_MANAGERS = ("easynav_navmap_maps_manager/NavMapMapsManager",)
 NAVMAP_INFLATION_FILTER = "easynav_navmap_maps_manager/NavMapMapsManager/InflationFilter"
-#: The NavMap InflationFilter's defaults (the original's), for a filter that sets neither.
-NAVMAP_INFLATION_DEFAULTS = {"inscribed_radius": 0.30, "inflation_radius": 0.30}
+#: The NavMap InflationFilter's default inflation radius (the original's).
+NAVMAP_INFLATION_RADIUS = 0.30
 BONXAI_MAPS_MANAGERS = ("easynav_bonxai_maps_manager/BonxaiMapsManager",)
 
 
@@ -80,21 +80,19 @@ def goal_height(description, waypoint) -> float:
 
 
 def _inflate_for_robot(maps: dict, alias: str, radius: float) -> dict[str, str]:
-    """Raise the inscribed (and inflation) radius of ``alias``'s NavMap InflationFilters to
-    ``radius`` where smaller; the notes, keyed by the filter's parameter prefix."""
+    """Raise the inflation radius of ``alias``'s NavMap InflationFilters to ``radius`` where
+    smaller; the notes, keyed by the filter's parameter prefix."""
     notes = {}
     for name in _get(maps, f"{alias}.filters", []) or []:
         if _get(maps, f"{alias}.{name}.plugin") != NAVMAP_INFLATION_FILTER:
             continue
-        changed = []
-        for key in ("inscribed_radius", "inflation_radius"):
-            value = float(_get(maps, f"{alias}.{name}.{key}", NAVMAP_INFLATION_DEFAULTS[key]))
-            if value < radius:
-                _set(maps, f"{alias}.{name}.{key}", float(radius))
-                changed.append(f"{key} {value:g} -> {radius:g}")
-        if changed:
+        key = f"{alias}.{name}.inflation_radius"
+        value = float(_get(maps, key, NAVMAP_INFLATION_RADIUS))
+        if value < radius:
+            _set(maps, key, float(radius))
             prefix = f"maps_manager_node.{alias}.{name} "
-            notes[prefix] = f"{prefix}{', '.join(changed)}: the world's robot is {radius:g} m"
+            notes[prefix] = (f"{prefix}inflation_radius {value:g} -> {radius:g}: the world's "
+                             f"robot is {radius:g} m")
     return notes
 
 
