@@ -77,21 +77,7 @@ class SimplePlanner(PathPlannerBase):
         self.planner = self._make_planner()
 
     def _robot_radius(self) -> float:
-        geometry = self.get_robot_geometry()
-        legacy = self.params.robot_radius  # NaN: not set
-        if math.isnan(legacy):
-            return geometry.radius
-        name = f"{self.plugin_name}.robot_radius"
-        if geometry.is_set("radius"):
-            self.logger.warning(
-                f"{name} is deprecated and ignored: system_node.robot_geometry.radius = "
-                f"{geometry.radius:g} takes precedence"
-            )
-            return geometry.radius
-        self.logger.warning(
-            f"{name} = {legacy:g} is deprecated: set system_node.robot_geometry.radius instead"
-        )
-        return legacy
+        return self.geometry_or_deprecated("robot_radius", "radius")
 
     # -- update -------------------------------------------------------------------------------
     def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,

@@ -108,6 +108,7 @@ class MethodBase(ParameterOwner):
         """Read the common parameters, then :meth:`on_initialize`."""
         self.context = context
         self.plugin_name = plugin_name
+        self._geometry_warnings.clear()  # a new configuration warns again
         try:
             self.read_declared_parameters(
                 context.parameters, plugin_name, warn=lambda message: self.logger.warning(message)
@@ -186,7 +187,7 @@ class MethodBase(ParameterOwner):
         file configures neither ``field`` nor a field it defaults to (``also_set_by``: the
         inscribed radius defaults to the radius); robot_geometry takes precedence when both are
         set, whatever its value (as in the original EasyNav). A set copy logs a warning, once per
-        message: deprecated, or deprecated and ignored.
+        message and configuration: deprecated, or deprecated and ignored.
         """
         geometry = self.get_robot_geometry()
         value = float(getattr(geometry, field))

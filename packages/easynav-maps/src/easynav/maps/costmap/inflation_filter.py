@@ -73,14 +73,12 @@ class InflationFilter(CostmapFilter):
         super().__init__()
         self._signature: tuple | None = None
         self._base_raw: np.ndarray | None = None
-        self._inscribed_warning: str | None = None
         self._table_key: tuple | None = None
         self._table: np.ndarray | None = None
 
     def on_initialize(self) -> None:
         self._signature = None
         self._base_raw = None
-        self._inscribed_warning = None
         self.inscribed_radius()  # warn now about a deprecated setting, not at the first cycle
         # Compile (or load from numba's cache) now, not in the first cycle.
         warm = np.zeros((3, 3), dtype=np.uint8)
@@ -93,30 +91,8 @@ class InflationFilter(CostmapFilter):
 
     def inscribed_radius(self) -> float:
         """The inscribed radius in use (m): robot_geometry's, or the deprecated parameter."""
-        geometry = self.get_robot_geometry()
-        legacy = self.params.inscribed_radius
-        if math.isnan(legacy):
-            return geometry.inscribed_radius
-        name = f"{self.plugin_name}.inscribed_radius"
-        # robot_geometry configures the inscribed radius when the params file sets it, or sets
-        # the radius it defaults to (as in the original EasyNav, robot_geometry takes precedence
-        # over the filter's own inscribed_radius, whatever its value).
-        if geometry.is_set("inscribed_radius") or geometry.is_set("radius"):
-            message = (
-                f"{name} is deprecated and ignored: system_node.robot_geometry.inscribed_radius "
-                f"= {geometry.inscribed_radius:g} takes precedence"
-            )
-            value = geometry.inscribed_radius
-        else:
-            message = (
-                f"{name} = {legacy:g} is deprecated: set "
-                "system_node.robot_geometry.inscribed_radius instead"
-            )
-            value = legacy
-        if message != self._inscribed_warning:
-            self.logger.warning(message)
-            self._inscribed_warning = message
-        return value
+        return self.geometry_or_deprecated("inscribed_radius", "inscribed_radius",
+                                           also_set_by=("radius",))
 
     def settings(self, resolution: float) -> tuple[int, np.ndarray]:
         """``(cell radius, cost table by squared cell distance)`` for ``resolution`` (the table

@@ -12,7 +12,6 @@ from easynav.common.sensors import PointPerception
 from easynav.common.tf import get_tf_buffer
 from easynav.core.nav_state import NavState
 from easynav.core.plugins import Param, RecoveryManagerBase
-from easynav.core.robot import RobotGeometry
 from easynav.core.types import DiagnosticStatus, Odometry, Twist, TwistStamped
 from easynav.recovery import nav_state_keys as keys
 from easynav.recovery.activation_aware_schedule import ActivationAwareSchedule
@@ -102,9 +101,8 @@ class SimpleRecoveryManager(RecoveryManagerBase):
 
     def on_initialize(self) -> None:
         self._read_tuning()
-        geometry = self.get_robot_geometry()
-        self.robot_radius = self._geometry_or_deprecated("robot_radius", geometry, "radius")
-        self.max_obstacle_z = self._geometry_or_deprecated("max_obstacle_z", geometry, "height")
+        self.robot_radius = self.geometry_or_deprecated("robot_radius", "radius")
+        self.max_obstacle_z = self.geometry_or_deprecated("max_obstacle_z", "height")
 
         self.schedule = ActivationAwareSchedule(self.freq, self._on_activation)
         self._slot = TakeoverSlot.for_cycle(self.context.system_freq)
@@ -147,24 +145,6 @@ class SimpleRecoveryManager(RecoveryManagerBase):
     def on_parameter_changed(self, name: str, value: object) -> None:
         """Tuning applies from the next cycle (``min_obstacle_z`` at the next configure)."""
         self._read_tuning()
-
-    def _geometry_or_deprecated(self, name: str, geometry: RobotGeometry, field: str) -> float:
-        geometry_value = getattr(geometry, field)
-        legacy = self.params[name]  # NaN: not set
-        if math.isnan(legacy):
-            return geometry_value
-        full = f"{self.plugin_name}.{name}"
-        if geometry.is_set(field):
-            # As in the original EasyNav, robot_geometry takes precedence when both are set.
-            self.logger.warning(
-                f"{full} is deprecated and ignored: system_node.robot_geometry.{field} = "
-                f"{geometry_value:g} takes precedence"
-            )
-            return geometry_value
-        self.logger.warning(
-            f"{full} = {legacy:g} is deprecated: set system_node.robot_geometry.{field} instead"
-        )
-        return legacy
 
     def _on_activation(self) -> None:
         self._activated = True
