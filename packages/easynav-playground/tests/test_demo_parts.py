@@ -190,6 +190,24 @@ def test_derived_params_point_the_costmap_manager_at_the_map_yaml(tmp_path):
     assert any("robot_geometry.radius = 0.15" in n for n in notes)
 
 
+def test_an_inscribed_radius_smaller_than_the_worlds_robot_is_raised(tmp_path):
+    # The inflation filters' cost 253 must reach the world's robot (a disc); a larger one stays.
+    for inscribed, expected in ((0.2, 0.3), (0.4, 0.4)):
+        source = tmp_path / "small.yaml"
+        source.write_text(
+            "system_node:\n  ros__parameters:\n"
+            f"    robot_geometry: {{radius: 0.2, inscribed_radius: {inscribed}}}\n"
+        )
+        out = tmp_path / "out.yaml"
+        notes, _ = derive_params(source, tmp_path / "w.map", (0, 0, 0), out, robot_radius=0.3)
+        system = yaml.safe_load(out.read_text())["system_node"]["ros__parameters"]
+        assert system["robot_geometry"]["inscribed_radius"] == expected
+        raised = [n for n in notes if "inscribed_radius" in n]
+        assert raised == ([
+            "system_node.robot_geometry.inscribed_radius 0.2 -> 0.3, the world's robot (a disc)"
+        ] if inscribed < 0.3 else [])
+
+
 def test_derived_params_point_the_voxel_maps_managers_at_the_world(tmp_path):
     import yaml
 

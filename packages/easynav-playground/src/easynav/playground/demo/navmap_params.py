@@ -14,8 +14,8 @@ wrote, for the NavMap stack (issue #17):
   ground floor's 2D map;
 - every NavMap ``InflationFilter`` inflates at least as far as the world's robot reaches: its
   ``inflation_radius`` is raised to the robot's radius when smaller (cost 253 reaches the
-  inscribed radius, the robot geometry's, which the demo sets to the world's robot, only
-  within the inflation radius);
+  robot geometry's inscribed radius, at least the world's robot in the demo, only within the
+  inflation radius);
 - every localizer alias with an ``initial_pose`` gets ``initial_pose.z``, the start floor's
   height, when the world has levels and the alias declares that key (the NavMap AMCL).
 

@@ -128,6 +128,13 @@ def derive_params(
         if _get(system, "robot_geometry.radius") != robot_radius:
             _set(system, "robot_geometry.radius", float(robot_radius))
             notes.append(f"system_node.robot_geometry.radius = {robot_radius:g}, the world's robot")
+        # The playground's robots are discs: an inscribed radius set for a smaller robot would
+        # let the inflation filters' cost 253 stop short of the world's robot.
+        inscribed = _get(system, "robot_geometry.inscribed_radius")
+        if inscribed is not None and float(inscribed) < robot_radius:
+            _set(system, "robot_geometry.inscribed_radius", float(robot_radius))
+            notes.append(f"system_node.robot_geometry.inscribed_radius {float(inscribed):g} -> "
+                         f"{robot_radius:g}, the world's robot (a disc)")
     if robot_radius is not None:
         notes.extend(_serest_margin_for_robot(params, float(robot_radius)))
     if robot_height is not None:
