@@ -298,3 +298,28 @@ def test_the_shipped_params_files_configure_the_plugin(name, space):
     planner = OMPLPlanner()
     planner.initialize(context, alias)
     assert planner.planner.state_space == space and planner.planner.planner == "RRTConnect"
+
+
+def test_ompl_over_a_gridmap_or_a_navmap_alone_is_refused_before_starting():
+    # The matrix found it: a GridMap stack with OMPL started, and OMPL never planned ("NavState
+    # 'map' holds a GridMap, not a Costmap2D"). Over a costmap or a SimpleMap it plans.
+    from easynav.core.plugins.compatibility import compatibility_errors
+    from easynav.maps.gridmap.gridmap_maps_manager import GridmapMapsManager
+    from easynav.maps.navmap.navmap_maps_manager import NavMapMapsManager
+    from easynav.maps.simple_maps_manager import SimpleMapsManager
+    from easynav.planners.ompl_planner import OMPLPlanner
+
+    ompl = ("ompl", "easynav_ompl_planner/OMPLPlanner", OMPLPlanner)
+    for alias, name, cls, provides in (
+        ("elevation", "easynav_gridmap_maps_manager/GridmapMapsManager", GridmapMapsManager,
+         "gridmap"),
+        ("mesh", "easynav_navmap_maps_manager/NavMapMapsManager", NavMapMapsManager, "navmap"),
+    ):
+        errors = compatibility_errors({"maps_manager_node": [(alias, name, cls)],
+                                       "planner_node": [ompl]})
+        assert errors == [
+            "planner_node.ompl [easynav_ompl_planner/OMPLPlanner] needs a map of type costmap "
+            f"or simple_map, but maps_manager_node.{alias} [{name}] provides {provides}"
+        ]
+    simple = ("simple", "easynav_simple_maps_manager/SimpleMapsManager", SimpleMapsManager)
+    assert compatibility_errors({"maps_manager_node": [simple], "planner_node": [ompl]}) == []

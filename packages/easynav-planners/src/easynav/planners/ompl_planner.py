@@ -68,6 +68,9 @@ class OMPLPlanner(PathPlannerBase):
     extra); ``update`` does not raise for unreachable goals (it reports them).
     """
 
+    #: It plans on a Costmap2D, or a SimpleMap's occupied cells: not on a GridMap or a NavMap
+    #: alone (a GridMap stack with it was accepted and never planned).
+    NEEDS_MAPS = ("costmap", "simple_map")
     PARAMETERS = (
         Param("freq", 1.0, "how often the path is checked (and replanned when needed)", "Hz",
               gt=0.0),
