@@ -79,19 +79,28 @@ def test_matches_a_direct_closest_approach_computation():
 
 
 def test_parameters_are_declared_with_the_original_names_and_defaults():
-    values = read_parameters(COLISION_CHECKER_PARAMETERS, DictParameters(), "")
-    assert dict(values) == {
+    """The original's names and defaults, except the robot's shape: robot_radius and
+    robot_height are deprecated copies of robot_geometry's (unset, NaN, by default)."""
+    values = dict(read_parameters(COLISION_CHECKER_PARAMETERS, DictParameters(), ""))
+    assert math.isnan(values.pop("colision_checker.robot_radius"))
+    assert math.isnan(values.pop("colision_checker.robot_height"))
+    assert values == {
         "colision_checker.active": False,
         "colision_checker.debug_markers": False,
-        "colision_checker.robot_radius": 0.35,
-        "colision_checker.robot_height": 0.5,
         "colision_checker.brake_acc": 0.5,
         "colision_checker.safety_margin": 0.1,
         "colision_checker.z_min_filter": 0.0,
         "colision_checker.downsample_leaf_size": 0.1,
     }
-    checker = ColisionChecker.from_parameters(values)
+    checker = ColisionChecker.from_parameters(
+        {**values, "colision_checker.robot_radius": 0.35, "colision_checker.robot_height": 0.5})
     assert checker.robot_radius == 0.35 and checker.downsample_leaf_size == 0.1
+    with pytest.raises(ParameterValueError, match="colision_checker.robot_radius = -0.1"):
+        read_parameters(
+            COLISION_CHECKER_PARAMETERS,
+            DictParameters({"colision_checker.robot_radius": -0.1}),
+            "",
+        )
     with pytest.raises(ParameterValueError, match="colision_checker.brake_acc = 0.0"):
         read_parameters(
             COLISION_CHECKER_PARAMETERS,

@@ -43,6 +43,60 @@ def test_active_checker_zeroes_a_command_into_a_point(params_file, runtime_facto
     assert nav_state.get("cmd_vel", TwistStamped) is command
 
 
+def _rosout(ros) -> list[str]:
+    # Every log message of every node (transient local: those logged before arrive too).
+    from rcl_interfaces.msg import Log
+    from rclpy.qos import QoSDurabilityPolicy, QoSProfile
+
+    texts: list[str] = []
+    qos = QoSProfile(depth=1000, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+    ros.create_node("checker_rosout").create_subscription(
+        Log, "/rosout", lambda m: texts.append(m.msg), qos)
+    return texts
+
+
+def test_checker_takes_the_robot_shape_from_robot_geometry(ros, params_file, runtime_factory):
+    """robot_geometry configures the checked circle and height; the original's own copies are
+    deprecated and ignored when both are set, and the whole check is deprecated (braking before
+    an obstacle is the recovery system's job): each said once in the log."""
+    document = system_params(**{
+        "system_node.robot_geometry.radius": 0.45,
+        "system_node.robot_geometry.height": 0.8,
+        "controller_node.colision_checker.active": True,
+        "controller_node.colision_checker.robot_radius": 0.3,
+    })
+    log = _rosout(ros)
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    checker = rt.system_node.subnodes["controller_node"].colision_checker
+    assert (checker.robot_radius, checker.robot_height) == (0.45, 0.8)
+    expected = [
+        "controller_node.colision_checker.robot_radius is deprecated and ignored: "
+        "system_node.robot_geometry.radius = 0.45 takes precedence",
+        "controller_node.colision_checker.active is deprecated: braking before an obstacle is "
+        "the recovery system's job",
+    ]
+    assert ros.spin_until(lambda: all(any(e in t for t in log) for e in expected), timeout=5.0)
+    assert [sum(e in t for t in log) for e in expected] == [1, 1]
+    assert not any("robot_height" in t for t in log)
+
+
+def test_checker_copy_applies_where_robot_geometry_is_unset(ros, params_file, runtime_factory):
+    document = system_params(**{
+        "controller_node.colision_checker.active": True,
+        "controller_node.colision_checker.robot_radius": 0.25,
+        "controller_node.colision_checker.robot_height": 1.2,
+    })
+    log = _rosout(ros)
+    rt = runtime_factory(params_file(document))
+    assert rt.start(), rt.error
+    checker = rt.system_node.subnodes["controller_node"].colision_checker
+    assert (checker.robot_radius, checker.robot_height) == (0.25, 1.2)
+    assert ros.spin_until(lambda: any(
+        "controller_node.colision_checker.robot_height = 1.2 is deprecated: set "
+        "system_node.robot_geometry.height instead" in t for t in log), timeout=5.0)
+
+
 def test_bad_value_fails_configuration_naming_it(params_file, runtime_factory):
     document = system_params(**{"controller_node.colision_checker.brake_acc": -1.0})
     rt = runtime_factory(params_file(document))

@@ -19,13 +19,18 @@ from easynav.core.plugins.declarations import Param
 #: Node-level parameters of controller_node (defaults of the original).
 COLISION_CHECKER_PARAMETERS = (
     Param("colision_checker.active", False,
-          "check each controller command against the point perceptions; zero it on a collision"),
+          "deprecated (the recovery system brakes before obstacles): check each controller "
+          "command against the point perceptions; zero it on a collision"),
     Param("colision_checker.debug_markers", False,
           "publish each check's box and points on collision_area (visualization_msgs/"
           "MarkerArray), red on a collision"),
-    Param("colision_checker.robot_radius", 0.35, "radius of the robot's circle", "m", gt=0.0),
-    Param("colision_checker.robot_height", 0.5, "points above this height are ignored", "m",
-          gt=0.0),
+    # The original's own copies of the robot's shape (0.35 m, 0.5 m): deprecated, unset by
+    # default, system_node.robot_geometry.radius / height stand in (controller_node resolves).
+    Param("colision_checker.robot_radius", math.nan,
+          "deprecated: system_node robot_geometry.radius", "m", gt=0.0, allow_nan=True),
+    Param("colision_checker.robot_height", math.nan,
+          "deprecated: system_node robot_geometry.height (points above it are ignored)", "m",
+          gt=0.0, allow_nan=True),
     Param("colision_checker.brake_acc", 0.5, "deceleration assumed to stop", "m/s^2", gt=0.0),
     Param("colision_checker.safety_margin", 0.1, "margin of the search box around the robot",
           "m", ge=0.0),

@@ -62,8 +62,9 @@ class ControllerNode(ComponentNode):
     recovery system proposed, :meth:`publish_cycle` selects (mux), smooths, guards and publishes.
     Parameters: ``controller_types``, ``<alias>.*``, ``robot_limits.*``, ``cmd_timeout`` (0.5 s),
     ``cmd_vel_keepalive_period`` (0.0 s), ``use_cmd_vel_stamped`` (false), ``colision_checker.*``
-    (with ``colision_checker.active``, each new controller command is checked by
-    :class:`ColisionChecker` against every point perception and zeroed on a collision; with
+    (deprecated, kept for the original's params files: with ``colision_checker.active``, each new
+    controller command is checked by :class:`ColisionChecker` against every point perception
+    and zeroed on a collision, the robot's circle and height from ``robot_geometry``; with
     ``colision_checker.debug_markers`` too, each check publishes the original's markers on
     ``collision_area``: see :meth:`check_collision`).
 
@@ -88,6 +89,7 @@ class ControllerNode(ComponentNode):
         self.published_any = False
         self.last_publish_monotonic: float | None = None
         self.colision_checker: ColisionChecker | None = None
+        self._checker_warnings: set[str] = set()  # warned in this configuration
         self.collision_marker_publisher = None
         self._marker_publisher = None
         system.robot_limits = self.limits_in_force
@@ -105,6 +107,7 @@ class ControllerNode(ComponentNode):
             stamped = self.forced_use_stamped
         self.use_stamped = stamped
         self._check_limits()
+        self._checker_warnings.clear()  # a new configuration warns again
         self._configure_colision_checker()
 
     def _check_limits(self) -> None:
@@ -113,8 +116,29 @@ class ControllerNode(ComponentNode):
             raise ConfigurationError("; ".join(errors))
 
     def _configure_colision_checker(self) -> None:
-        # The checker of the colision_checker.* values in force (None while inactive).
-        values = self.node_values
+        # The checker of the colision_checker.* values in force (None while inactive). Its
+        # robot_radius / robot_height are deprecated copies of system_node.robot_geometry's
+        # radius / height, which take precedence where configured (warned once per message
+        # and configuration). The whole check is deprecated: braking before an obstacle is
+        # the recovery system's job; it stays for the original's params files.
+        values = dict(self.node_values)
+        geometry = self.system.robot_geometry()
+        messages = []
+        for copy, field in (("robot_radius", "radius"), ("robot_height", "height")):
+            key = f"colision_checker.{copy}"
+            values[key], message = geometry.or_deprecated_copy(
+                field, f"{self.get_name()}.{key}", float(values[key]))
+            messages.append(message)
+        if values["colision_checker.active"]:
+            messages.append(
+                f"{self.get_name()}.colision_checker.active is deprecated: braking before an "
+                "obstacle is the recovery system's job (the brake of easynav_simple_recovery/"
+                "SimpleRecoveryManager)"
+            )
+        for message in messages:
+            if message is not None and message not in self._checker_warnings:
+                self._checker_warnings.add(message)
+                self.get_logger().warning(message)
         self.colision_checker = (
             ColisionChecker.from_parameters(values) if values["colision_checker.active"] else None
         )

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any, ClassVar
 
 from easynav.core.plugins.declarations import Param, ParameterValueError, ParameterValues, Topic
@@ -189,19 +188,10 @@ class MethodBase(ParameterOwner):
         set, whatever its value (as in the original EasyNav). A set copy logs a warning, once per
         message and configuration: deprecated, or deprecated and ignored.
         """
-        geometry = self.get_robot_geometry()
-        value = float(getattr(geometry, field))
-        legacy = self.params[name]
-        if math.isnan(legacy):
+        value, message = self.get_robot_geometry().or_deprecated_copy(
+            field, f"{self.plugin_name}.{name}", float(self.params[name]), also_set_by)
+        if message is None:
             return value
-        full = f"{self.plugin_name}.{name}"
-        if any(geometry.is_set(f) for f in (field, *also_set_by)):
-            message = (f"{full} is deprecated and ignored: system_node.robot_geometry.{field} = "
-                       f"{value:g} takes precedence")
-        else:
-            message = (f"{full} = {legacy:g} is deprecated: set "
-                       f"system_node.robot_geometry.{field} instead")
-            value = float(legacy)
         if message not in self._geometry_warnings:
             self._geometry_warnings.add(message)
             self.logger.warning(message)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import threading
 from dataclasses import dataclass, field
 from typing import Any
@@ -27,6 +28,25 @@ class RobotGeometry:
     def is_set(self, name: str) -> bool:
         """Whether the user configured field ``name`` (``radius``, ...)."""
         return name in self.user_set
+
+    def or_deprecated_copy(self, field_name: str, copy_name: str, copy_value: float,
+                           also_set_by: tuple[str, ...] = ()) -> tuple[float, str | None]:
+        """The value of field ``field_name``, or of a component's deprecated copy of it.
+
+        ``copy_name`` is the copy's full parameter name (for the message), ``copy_value`` its
+        value, NaN when unset. The copy applies only where the user configured neither the field
+        nor a field it defaults to (``also_set_by``: the inscribed radius defaults to the
+        radius). Returns the value and, when the copy is set, the warning to log: deprecated, or
+        deprecated and ignored.
+        """
+        value = float(getattr(self, field_name))
+        if math.isnan(copy_value):
+            return value, None
+        if any(self.is_set(f) for f in (field_name, *also_set_by)):
+            return value, (f"{copy_name} is deprecated and ignored: system_node.robot_geometry."
+                           f"{field_name} = {value:g} takes precedence")
+        return float(copy_value), (f"{copy_name} = {copy_value:g} is deprecated: set "
+                                   f"system_node.robot_geometry.{field_name} instead")
 
 
 class RobotGeometryRegistry:
