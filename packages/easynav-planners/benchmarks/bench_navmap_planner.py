@@ -15,15 +15,18 @@ goal on a free NavCel of the upper floor, so every path climbs the ramp.
 
 Figures: CPU time (this process; the machine is shared) of the compiled A* search alone and of
 a whole planner cycle (``NavMapAStarPlanner.update``: locating robot and goal, step
-multipliers, search, smoothing, poses), median over the pairs of the best of ``--repeats``;
+multipliers, search, straightening, poses), median over the pairs of the best of ``--repeats``;
 the reference is ``scipy.sparse.csgraph.dijkstra`` from the start NavCel on the same weighted
 graph (CSR built once, outside the timing; it does not stop at the goal, A* does). Costs: the
 planner's optimal cost against Dijkstra's distance to the goal (relative difference). The
-pure-Python reference A* is timed on the first pair for context.
+pure-Python reference A* is timed on the first pair for context. Straightening
+(``shortcut_path``): the compiled twin against the pure-Python reference on the same A* paths
+(and the same answer), with the straightened length over the A* path's, for context.
 
 Goals: the search's median <= 1.5 x Dijkstra's and <= 50 ms (A* stops at the goal but, with the
 goal above the start, expands most of the mesh before finding the ramp: about Dijkstra's work),
-a whole cycle <= 100 ms (a 10 Hz planner), the same optimal costs (relative difference <= 1e-9).
+a whole cycle <= 100 ms (a 10 Hz planner), the same optimal costs (relative difference <= 1e-9),
+straightening <= 10 ms.
 """
 
 from __future__ import annotations
@@ -49,6 +52,7 @@ from easynav.planners.navmap_astar import (
     step_multipliers,
 )
 from easynav.planners.navmap_planner import NavMapAStarPlanner
+from easynav.planners.navmap_shortcut import shortcut_path, shortcut_path_reference
 
 RES = 0.1
 UPPER_Z = 3.0
@@ -138,8 +142,11 @@ def main() -> None:
     nav_state.set("map.navmap", navmap)
     navmap.locate(np.array([jobs[0][0]]))  # build the spatial index (once per map)
     astar_navmap(navmap.neighbors, navmap.centroids, mult, 0, 1)  # compile / load the cache
+    shortcut_path(navmap.centroids[:3], np.array([0, 1, 2]), navmap.vertices, navmap.faces,
+                  navmap.neighbors, mult)  # likewise
 
     search, cycle, ref, diffs, lengths = [], [], [], [], []
+    straighten, straighten_py, shorter, same = [], [], [], True
     for start, goal in jobs:
         s, g = (navmap.locate_navcel(p) for p in (start, goal))
         t, (cells, cost) = best_ms(
@@ -152,6 +159,15 @@ def main() -> None:
             raise SystemExit(f"pair {start} -> {goal}: ours {cells is not None}, Dijkstra "
                              f"{math.isfinite(dist[g])}: both must find the path")
         diffs.append(abs(cost - dist[g]) / dist[g])
+        inputs = (navmap.centroids[cells], cells, navmap.vertices, navmap.faces,
+                  navmap.neighbors, mult)
+        t, (xy, crossed) = best_ms(lambda inputs=inputs: shortcut_path(*inputs), args.repeats)
+        straighten.append(t)
+        t, (xy_py, crossed_py) = best_ms(lambda inputs=inputs: shortcut_path_reference(*inputs), 1)
+        straighten_py.append(t)
+        same = same and np.array_equal(crossed, crossed_py) and np.allclose(xy, xy_py, atol=1e-12)
+        staircase = np.linalg.norm(np.diff(navmap.centroids[cells][:, :2], axis=0), axis=1).sum()
+        shorter.append(float(np.linalg.norm(np.diff(xy, axis=0), axis=1).sum()) / staircase)
         nav_state.set("robot_pose", Odometry(Header(0.0, "map"), "base_footprint",
                                              Pose.from_xy_yaw(start[0], start[1], 0.0, start[2])))
         nav_state.set("goals", Goals(Header(0.0, "map"), [PoseStamped(
@@ -186,6 +202,12 @@ def main() -> None:
         BenchRow("NavMapAStarPlanner.update (whole cycle), median", cyc, "ms", reference,
                  ref_med, goal="<= 100 ms (a 10 Hz planner)", met=bool(cyc <= 100.0)),
         BenchRow("pure-Python reference A*, first pair", t_py, "ms", reference, ref[0]),
+        BenchRow(f"straightening the A* path (compiled), median of {len(jobs)} pairs",
+                 p(straighten, 50), "ms", "pure-Python reference straightening, same paths",
+                 p(straighten_py, 50), goal="<= 10 ms and the reference's answer",
+                 met=bool(p(straighten, 50) <= 10.0 and same)),
+        BenchRow("straightened path length / A* path length (xy), median", p(shorter, 50), "",
+                 "the A* path through NavCel centroids"),
         BenchRow("largest relative path-cost difference to Dijkstra", max_diff, "",
                  "scipy csgraph.dijkstra", goal="<= 1e-9", met=bool(max_diff <= 1e-9)),
     ]

@@ -35,6 +35,7 @@ from easynav.planners.navmap_planner import (
     clamp_to_triangles,
     smooth_on_navcels,
 )
+from easynav.planners.navmap_shortcut import shortcut_path, walk_segment
 
 _namespaces = itertools.count()
 RES = 0.1
@@ -404,3 +405,166 @@ def test_no_navmap_yet():
     planner.update(nav_state)
     assert len(nav_state.get("path", Path)) == 0
     assert "no NavMap yet" in diagnostic(nav_state).message
+
+
+# -- straightening (smooth_path) ------------------------------------------------------------
+def walk_cost_of(navmap, mult, xy, cells) -> float:
+    """The cost of a straightened path under the planner's model, recomputed here: each
+    segment's length inside each NavCel (found by sampling the segment densely and locating
+    the samples) times that NavCel's multiplier."""
+    total = 0.0
+    for a, b in zip(xy[:-1], xy[1:], strict=True):
+        n = max(2, int(np.hypot(*(b - a)) / 0.002))
+        ts = (np.arange(n) + 0.5) / n
+        samples = a[None, :] + ts[:, None] * (b - a)[None, :]
+        cids, _ = navmap.locate(np.column_stack([samples, np.zeros(n)]))
+        assert (cids >= 0).all(), "a straightened segment leaves the mesh"
+        total += float((mult[cids] * np.hypot(*(b - a)) / n).sum())
+    return total
+
+
+def test_walk_segment_follows_the_line_and_refuses_what_it_must():
+    navmap = merge(patch(0, 2, 0, 1))
+    xy, faces, nbrs = navmap.vertices[:, :2], navmap.faces, navmap.neighbors
+    mult = step_multipliers(None, navmap.num_navcels, 2.0, 5.0)
+    p, q = np.array([0.13, 0.07]), np.array([1.71, 0.88])
+    cids, _ = navmap.locate(np.array([[*p, 0.0], [*q, 0.0]]))
+    walked = walk_segment(xy, faces, nbrs, mult, int(cids[0]), int(cids[1]), p, q)
+    assert walked is not None
+    crossed, entries, cost = walked
+    assert crossed[-1] == cids[1]
+    assert cost == pytest.approx(2.0 * np.hypot(*(q - p)), rel=1e-12)
+    steps = [int(cids[0]), *crossed]
+    assert all(b in navmap.neighbors[a] for a, b in zip(steps[:-1], steps[1:], strict=True))
+    for e in entries:  # every crossing lies on the line
+        assert abs((q - p)[0] * (e[1] - p[1]) - (q - p)[1] * (e[0] - p[0])) < 1e-12
+    blocked = mult.copy()
+    blocked[crossed[len(crossed) // 2]] = np.inf
+    assert walk_segment(xy, faces, nbrs, blocked, int(cids[0]), int(cids[1]), p, q) is None
+    # Through vertices, across the grid's other diagonal (every grid point on x + y = 1):
+    # walked as if just right of them, the NavCels round each vertex on that side included.
+    a, b = np.array([0.1 + 0.2 / 3, 0.9 - 0.2 / 3]), np.array([0.9 - 0.1 / 3, 0.1 + 0.1 / 3])
+    ends, _ = navmap.locate(np.array([[*a, 0.0], [*b, 0.0]]))
+    walked = walk_segment(xy, faces, nbrs, mult, int(ends[0]), int(ends[1]), a, b)
+    assert walked is not None
+    crossed, entries, cost = walked
+    assert cost == pytest.approx(2.0 * np.hypot(*(b - a)), rel=1e-12)
+    steps = [int(ends[0]), *crossed]
+    assert all(n in navmap.neighbors[m] for m, n in zip(steps[:-1], steps[1:], strict=True))
+    right = navmap.centroids[crossed][:, :2] - a
+    assert ((b - a)[0] * right[:, 1] - (b - a)[1] * right[:, 0] <= 1e-12).all()
+    vertex = walked[1][len(walked[1]) // 2]
+    vertex_blocked = mult.copy()  # a NavCel right of a vertex on the line, on the way
+    vertex_blocked[crossed[len(crossed) // 2]] = np.inf
+    assert walk_segment(xy, faces, nbrs, vertex_blocked, int(ends[0]), int(ends[1]), a, b) is None
+    assert vertex is not None
+    # Off the mesh and back: refused.
+    holed = merge(patch(0, 1, 0, 1), patch(1, 2, 0, 0.5), patch(1, 2, 0.5, 1), patch(2, 3, 0, 1))
+    keep = holed.centroids[:, 0] < 1.0
+    keep |= holed.centroids[:, 0] > 2.0
+    keep |= holed.centroids[:, 1] < 0.5
+    cut = NavMap(holed.vertices, holed.faces[keep])
+    a, b = np.array([0.5, 0.9]), np.array([2.5, 0.9])
+    ends, _ = cut.locate(np.array([[*a, 0.0], [*b, 0.0]]))
+    free = step_multipliers(None, cut.num_navcels, 2.0, 5.0)
+    assert walk_segment(cut.vertices[:, :2], cut.faces, cut.neighbors, free, int(ends[0]),
+                        int(ends[1]), a, b) is None
+
+
+def test_straightened_path_across_the_grid_diagonal_is_the_straight_line():
+    """On a grid mesh split along one diagonal, A* across the other diagonal returns a
+    staircase of right-angle turns (the original's path); straightened, it is the line."""
+    navmap = merge(patch(0, 4, 0, 4))
+    start, goal = (3.53, 0.47, 0.0), (0.47, 3.53, 0.0, 2.0)
+    _, _, original = plan(navmap, goal, robot=start, params={"smooth_path": False})
+    _, _, straight = plan(navmap, goal, robot=start)
+    for path in (original, straight):
+        pts = points(path)
+        assert pts[0] == pytest.approx(start) and pts[-1] == pytest.approx(goal[:3])
+    length = math.hypot(3.06, 3.06)
+    turns = np.abs(np.diff(np.unwrap([p.yaw for p in original.poses[:-1]])))
+    assert (turns > math.radians(10)).sum() >= 30  # the staircase, smoothed a little
+    wiggly = np.linalg.norm(np.diff(points(original)[:, :2], axis=0), axis=1).sum()
+    assert wiggly > 1.2 * length
+    pts = points(straight)
+    d = np.diff(pts[:, :2], axis=0)
+    assert np.linalg.norm(d, axis=1).sum() == pytest.approx(length, rel=1e-9)
+    assert np.allclose([p.yaw for p in straight.poses[:-1]], math.atan2(3.06, -3.06))
+    assert straight.poses[-1].yaw == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_straightened_path_is_never_costlier_and_stays_on_enterable_navcels(seed):
+    rng = np.random.default_rng(100 + seed)
+    navmap = random_mesh(rng)
+    costs = rng.choice([0, 0, 0, 0, 50, 120, 200, 253, 254], navmap.num_navcels).astype(np.uint8)
+    mult = step_multipliers(costs, navmap.num_navcels, 2.0, 5.0)
+    free = np.flatnonzero(np.isfinite(mult))
+    for _ in range(5):
+        s, g = (int(c) for c in rng.choice(free, 2, replace=False))
+        cells, _ = astar_navmap_reference(navmap.neighbors, navmap.centroids, mult, s, g)
+        if cells is None:
+            continue
+        pts = navmap.centroids[cells]
+        xy, crossed = shortcut_path(pts, cells, navmap.vertices[:, :2], navmap.faces,
+                                    navmap.neighbors, mult)
+        assert xy[0] == pytest.approx(pts[0, :2]) and xy[-1] == pytest.approx(pts[-1, :2])
+        assert crossed[0] == s and crossed[-1] == g
+        assert np.isfinite(mult[crossed]).all()
+        assert all(b in navmap.neighbors[a] or a == b
+                   for a, b in zip(crossed[:-1], crossed[1:], strict=True))
+        # Both costs as lines over the flattened mesh (the multiplier of the NavCel under
+        # each point, integrated along the polyline): the straightened path's is no more.
+        flat = NavMap(np.column_stack([navmap.vertices[:, :2], np.zeros(len(navmap.vertices))]),
+                      navmap.faces)
+        before = walk_cost_of(flat, mult, pts[:, :2], cells)
+        assert walk_cost_of(flat, mult, xy, crossed) <= before * (1 + 1e-3) + 1e-6
+
+
+def test_straightened_path_never_cuts_into_costlier_navcels_than_its_stretch():
+    """The band of inflated NavCels the path goes round (test_layer_costs_push_the_path_away):
+    the straightened path goes round it as well, on free NavCels only (a line across the
+    band's corner would be shorter, and under the cost model even cheaper than A*'s
+    staircase), with straight stretches instead of the staircase."""
+    navmap = merge(patch(0, 6, 0, 4))
+    c = navmap.centroids
+    band = (np.abs(c[:, 0] - 3.0) < 0.5) & (c[:, 1] < 3.0)
+    navmap.add_layer("inflated_obstacles")[band] = 250
+    goal, robot = (5.5, 1.5, 0.0), (0.5, 1.5, 0.0)
+    planner, _, path = plan(navmap, goal, robot)
+    assert not band[planner._last_crossed].any()
+    pts = points(path)
+    middle = np.abs(pts[:, 0] - 3.0) < 0.4
+    assert middle.any() and (pts[middle, 1] > 3.0).all()
+    _, _, original = plan(navmap, goal, robot, {"smooth_path": False})
+    for p in (path, original):
+        assert not band[navmap.locate(points(p))[0]].any()
+    turns = [np.abs(np.diff(np.unwrap([p.yaw for p in q.poses[:-1]]))) for q in (path, original)]
+    assert (turns[0] > math.radians(10)).sum() < (turns[1] > math.radians(10)).sum() / 4
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_compiled_straightening_gives_the_reference_answer(seed):
+    pytest.importorskip("numba")  # the numba extra (installed by the repository's set-up)
+    from easynav.planners import navmap_shortcut
+
+    assert navmap_shortcut._KERNEL.available()
+    rng = np.random.default_rng(200 + seed)
+    navmap = random_mesh(rng, n=30)
+    costs = rng.choice([0, 0, 0, 0, 0, 50, 120, 253, 254], navmap.num_navcels).astype(np.uint8)
+    mult = step_multipliers(costs, navmap.num_navcels, 2.0, 5.0)
+    free = np.flatnonzero(np.isfinite(mult))
+    compared = 0
+    for _ in range(8):
+        s, g = (int(c) for c in rng.choice(free, 2, replace=False))
+        cells, _ = astar_navmap_reference(navmap.neighbors, navmap.centroids, mult, s, g)
+        if cells is None or len(cells) < 3:
+            continue
+        args = (navmap.centroids[cells], np.asarray(cells), navmap.vertices, navmap.faces,
+                navmap.neighbors, mult)
+        ref_xy, ref_cells = navmap_shortcut.shortcut_path_reference(*args)
+        fast_xy, fast_cells = navmap_shortcut.shortcut_path(*args)
+        np.testing.assert_array_equal(fast_cells, ref_cells)
+        np.testing.assert_allclose(fast_xy, ref_xy, rtol=0, atol=1e-12)
+        compared += 1
+    assert compared >= 3

@@ -13,6 +13,7 @@ from easynav.core.types import Goals, Header, Odometry, Path, Pose
 from easynav.maps.navmap import LETHAL_OBSTACLE, NO_INFORMATION, NavMap
 from easynav.maps.navmap.keys import MAP_NAVMAP
 from easynav.planners.navmap_astar import astar_navmap, compiled_available, step_multipliers
+from easynav.planners.navmap_shortcut import shortcut_path
 from easynav.planners.path_planner_base import DIAGNOSTIC_NAME, HARDWARE_ID, PathPlannerBase
 
 __all__ = [
@@ -28,6 +29,9 @@ COST_LAYERS = ("inflated_obstacles", "obstacles")
 #: The original's smoothing: 5 Laplacian iterations with weight 0.4.
 SMOOTHING_ITERATIONS = 5
 SMOOTHING_ALPHA = 0.4
+#: Points of a straightened path closer than this (m, xy) to the one before are dropped: the
+#: line's crossings of NavCel edges near a vertex, whose heading would be noise.
+MIN_POINT_SPACING = 0.01
 #: Farthest (m, 3-D) the robot may be from the nearest NavCel centroid when no NavCel lies
 #: under it (localisation noise at the edge of the mesh); farther, it is off the NavMap.
 MAX_START_GAP = 1.0
@@ -125,11 +129,16 @@ class NavMapAStarPlanner(PathPlannerBase):
     free one with ``cost_factor`` 2, so the path keeps away from obstacles where room allows.
 
     Path: the robot's point on its NavCel, the centroids of the NavCels in between, and the
-    goal's point on its NavCel (the original uses the end NavCels' centroids), smoothed by the
-    original's 5 rounds of Laplacian smoothing (weight 0.4), each point clamped to its own
-    NavCel (:func:`smooth_on_navcels`), ends fixed. Poses are 3-D: z on the surface, each
-    facing the next in xy, the last with the goal's yaw. When the robot is already on the goal's
-    NavCel the path is the goal's point alone.
+    goal's point on its NavCel (the original uses the end NavCels' centroids). With
+    ``smooth_path`` (true; beyond the original) it is shortened by straight lines across the
+    NavCels (:func:`~easynav.planners.navmap_shortcut.shortcut_path`): on a mesh made from a
+    grid, A*'s path across the grid's other diagonal is a staircase of right-angle turns, each
+    of which slows the controller down. A line replaces a stretch of path only where it crosses
+    no NavCel costlier than the stretch's costliest, and costs no more; its points are where it
+    crosses NavCel edges, z on the surface. False: the original's 5 rounds of Laplacian
+    smoothing (weight 0.4), each point clamped to its own NavCel (:func:`smooth_on_navcels`),
+    ends fixed. Poses are 3-D: each facing the next in xy, the last with the goal's yaw. When
+    the robot is already on the goal's NavCel the path is the goal's point alone.
 
     NavState: reads ``goals`` (plans to the first; its z picks the floor), ``robot_pose`` (its z
     likewise), ``map.navmap``; writes ``path`` (stamped now, in the map frame) and
@@ -165,6 +174,12 @@ class NavMapAStarPlanner(PathPlannerBase):
         ),
         Param("continuous_replan", True, "plan every cycle (false: only on a new goal or block)"),
         Param(
+            "smooth_path",
+            True,
+            "shorten the A* path by straight lines across the NavCels, never through costlier "
+            "NavCels nor at a higher cost (false: the original's path, Laplacian-smoothed)",
+        ),
+        Param(
             "max_allowed_slope_deg",
             90.0,
             "NavCels tilted more than this from horizontal are never entered (90: no limit, "
@@ -180,7 +195,8 @@ class NavMapAStarPlanner(PathPlannerBase):
     def __init__(self) -> None:
         super().__init__()
         self._last_goal: tuple | None = None
-        self._last_cells: np.ndarray | None = None
+        self._last_cells: np.ndarray | None = None  # the last search's NavCels
+        self._last_crossed: np.ndarray | None = None  # the NavCels its path crosses
         self._last_path: Path | None = None
         self._last_geometry: tuple[np.ndarray, np.ndarray] | None = None
 
@@ -195,6 +211,7 @@ class NavMapAStarPlanner(PathPlannerBase):
     def forget_path(self) -> None:
         """The kept path (``continuous_replan`` false) is no longer the answer."""
         self._last_goal = self._last_cells = self._last_path = self._last_geometry = None
+        self._last_crossed = None
 
     # -- helpers ------------------------------------------------------------------------------
     @staticmethod
@@ -301,12 +318,35 @@ class NavMapAStarPlanner(PathPlannerBase):
         else:
             points = navmap.centroids[cells].copy()
             points[0], points[-1] = start_point, goal_point
-            points = smooth_on_navcels(points, cells, navmap)
+            if self.params.smooth_path:
+                points, crossed = self._straightened(navmap, points, cells, mult)
+            else:
+                points, crossed = smooth_on_navcels(points, cells, navmap), cells
         path = Path(Header(self.now(), map_frame), self._poses(points, goal[2]))
         self._last_goal, self._last_cells, self._last_path = key, cells, path
+        self._last_crossed = cells if len(cells) == 1 else crossed
         self._last_geometry = (navmap.vertices, navmap.faces)
         length = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
         self.write_path(nav_state, path, f"path of {length:.2f} m to {goal_text}")
+
+    @staticmethod
+    def _straightened(navmap: NavMap, points: np.ndarray, cells: np.ndarray,
+                      mult: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The path pulled straight (:func:`shortcut_path`), 3-D on its NavCels, without
+        points closer than ``MIN_POINT_SPACING`` to the one before (the ends kept)."""
+        xy, crossed = shortcut_path(points, cells, navmap.vertices, navmap.faces,
+                                    navmap.neighbors, mult)
+        keep = np.ones(len(xy), dtype=bool)
+        last = 0
+        for k in range(1, len(xy) - 1):
+            if np.hypot(*(xy[k] - xy[last])) < MIN_POINT_SPACING:
+                keep[k] = False
+            else:
+                last = k
+        xy, crossed = xy[keep], crossed[keep]
+        out = clamp_to_triangles(xy, navmap.vertices[navmap.faces[crossed]])
+        out[0], out[-1] = points[0], points[-1]
+        return out, crossed
 
     @staticmethod
     def _poses(points: np.ndarray, goal_yaw: float) -> list[Pose]:
@@ -319,7 +359,7 @@ class NavMapAStarPlanner(PathPlannerBase):
                 for p, a in zip(points, yaw, strict=True)]
 
     def _can_keep(self, navmap: NavMap, mult: np.ndarray, key: tuple) -> bool:
-        if (self._last_path is None or self._last_goal != key or self._last_cells is None
+        if (self._last_path is None or self._last_goal != key or self._last_crossed is None
                 or self._last_geometry is None):
             return False
         vertices, faces = self._last_geometry
@@ -327,4 +367,4 @@ class NavMapAStarPlanner(PathPlannerBase):
             np.array_equal(faces, navmap.faces) and np.array_equal(vertices, navmap.vertices))
         if not same:
             return False
-        return bool(np.isfinite(mult[self._last_cells[1:]]).all())
+        return bool(np.isfinite(mult[self._last_crossed[1:]]).all())

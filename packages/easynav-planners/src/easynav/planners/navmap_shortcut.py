@@ -1,0 +1,228 @@
+"""Straightening an A* path over a NavMap: shortcuts across the NavCels, never costlier.
+
+A* over NavCels sharing an edge pays the distance between centroids. On a mesh made from an
+occupancy grid (two NavCels per cell, split along one diagonal) every route across the other
+diagonal then costs the same as a Manhattan staircase, and A* returns one: straight runs and
+right-angle turns every few cells, which the original's smoothing (a few Laplacian rounds)
+barely touches. A controller slows down for every one of those turns.
+
+:func:`shortcut_path` pulls the path straight: from each kept point it jumps to the farthest
+later point it can reach by a straight line (in xy) across the mesh, when the straight line
+crosses no NavCel costlier than the costliest of the stretch of path it replaces, and costs
+no more than that stretch under the planner's own cost model (the length inside each NavCel
+times its multiplier, :func:`~easynav.planners.navmap_astar.step_multipliers`; the path's own
+steps measured the same way, :func:`path_step_costs`). So a shortcut never enters a NavCel A*
+would never enter, and never trades a detour around an inflated obstacle for a line through
+its inflation: a path that kept to free NavCels stays on free NavCels.
+
+The line is followed from NavCel to NavCel through shared edges (:func:`walk_segment`), so it
+stays on the surface the path is on: floors above or below the same (x, y) are not reached,
+and a ramp is followed up. Points of the result: the kept path points, and between them the
+points where the line crosses from one NavCel to the next, each with its NavCel (for its
+height).
+
+:func:`shortcut_path` is the plain function the planner calls: the compiled twin when numba is
+installed (``pip install easynav-planners[numba]``), else :func:`shortcut_path_reference`. Any
+thread (no shared state).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from easynav.planners.compiled_kernel import CompiledKernel
+
+
+def _cross(ax: float, ay: float, bx: float, by: float) -> float:
+    return ax * by - ay * bx
+
+
+def walk_segment(
+    xy: np.ndarray,
+    faces: np.ndarray,
+    neighbors: np.ndarray,
+    mult: np.ndarray,
+    start: int,
+    target: int,
+    p: tuple[float, float],
+    q: tuple[float, float],
+    limit: float = math.inf,
+    max_steps: int = 100000,
+) -> tuple[list[int], list[tuple[float, float]], float] | None:
+    """Follow the straight line from ``p`` (in NavCel ``start``) to ``q`` (in NavCel
+    ``target``) across shared edges.
+
+    ``xy`` (V, 2+) vertex positions (x, y first; a z column is ignored), ``faces`` (M, 3),
+    ``neighbors`` (M, 3) (``neighbors[c, e]`` across edge ``faces[c, e] -> faces[c, (e+1) %
+    3]``, -1 at a border), ``mult`` (M,) step multipliers. Returns the NavCels crossed after
+    ``start`` (``target`` last), the points where the line enters each of them, and the line's
+    cost (each length inside a NavCel times its multiplier, ``start``'s included); None when the
+    line leaves the mesh, enters a NavCel of infinite multiplier or of a multiplier above
+    ``limit``, or ends elsewhere than ``target``.
+
+    A line through a vertex (every 45-degree line between centroids of a grid mesh is one) is
+    walked as if shifted an infinitesimal amount to the right of it: a vertex on the line
+    counts as left of it. The NavCels round the vertex on that side are then crossed (with no
+    length inside them) and must be enterable too.
+    """
+    px, py = float(p[0]), float(p[1])
+    dx, dy = float(q[0]) - px, float(q[1]) - py
+    length = math.hypot(dx, dy)
+    cid, came_from = int(start), -1
+    t_in = 0.0
+    cost = 0.0
+    cells: list[int] = []
+    entries: list[tuple[float, float]] = []
+    for _ in range(max_steps):
+        if cid == target:
+            return cells, entries, cost + max(0.0, 1.0 - t_in) * length * float(mult[cid])
+        corners = [xy[faces[cid, k]] for k in range(3)]
+        # Side of the line of each corner: True left (or on it), False right.
+        left = [_cross(dx, dy, float(c[0]) - px, float(c[1]) - py) >= 0.0 for c in corners]
+        exit_e, exit_t = -1, -math.inf
+        for e in range(3):
+            if left[e] == left[(e + 1) % 3]:
+                continue  # the (shifted) line does not cross this edge
+            nb = int(neighbors[cid, e])
+            if came_from >= 0 and nb == came_from:
+                continue  # the edge it came in by
+            a, b = corners[e], corners[(e + 1) % 3]
+            ex, ey = float(b[0] - a[0]), float(b[1] - a[1])
+            denom = _cross(dx, dy, ex, ey)
+            t = _cross(float(a[0]) - px, float(a[1]) - py, ex, ey) / denom
+            if t > exit_t:
+                exit_e, exit_t = e, t
+        if exit_e < 0 or exit_t >= 1.0:
+            return None  # q lies in this NavCel, which is not the target
+        nb = int(neighbors[cid, exit_e])
+        if nb < 0 or not float(mult[nb]) <= limit or not math.isfinite(float(mult[nb])):
+            return None
+        exit_t = max(exit_t, t_in)
+        cost += (exit_t - t_in) * length * float(mult[cid])
+        t_in = exit_t
+        came_from, cid = cid, nb
+        cells.append(cid)
+        entries.append((px + exit_t * dx, py + exit_t * dy))
+    return None
+
+
+def path_step_costs(
+    points: np.ndarray,
+    cells: np.ndarray,
+    xy: np.ndarray,
+    faces: np.ndarray,
+    neighbors: np.ndarray,
+    mult: np.ndarray,
+) -> np.ndarray:
+    """(N-1,) the cost of each step of the path ``points`` (N, 2+) through NavCels ``cells``
+    as a line: its length inside each NavCel times that NavCel's multiplier. A step the line
+    walk refuses (it grazes a vertex, or skirts a third NavCel) costs its length times the
+    mean of its two NavCels' multipliers."""
+    pts = np.asarray(points, dtype=np.float64)[:, :2]
+    out = np.empty(len(cells) - 1)
+    for k in range(len(cells) - 1):
+        walked = walk_segment(xy, faces, neighbors, mult, int(cells[k]), int(cells[k + 1]),
+                              pts[k], pts[k + 1])
+        if walked is not None:
+            out[k] = walked[2]
+        else:
+            out[k] = float(np.hypot(*(pts[k + 1] - pts[k]))) * 0.5 * float(
+                mult[cells[k]] + mult[cells[k + 1]])
+    return out
+
+
+def shortcut_path_reference(
+    points: np.ndarray,
+    cells: np.ndarray,
+    xy: np.ndarray,
+    faces: np.ndarray,
+    neighbors: np.ndarray,
+    mult: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The path ``points`` (N, 2+) through NavCels ``cells`` (N,), pulled straight (module
+    documentation). Returns the xy points (K, 2) and their NavCels (K,), ends unchanged.
+
+    From each kept point, the farthest later point reachable by a line no costlier than the
+    path is found by doubling the jump until a line fails, then halving between the last
+    success and the failure (a line that fails in between is not looked for: the result is
+    straighter, not necessarily the straightest).
+
+    Pure Python: the readable version the tests check the compiled one against."""
+    pts = np.asarray(points, dtype=np.float64)[:, :2]
+    cells = np.asarray(cells, dtype=np.int64)
+    n = len(cells)
+    if n < 3:
+        return pts.copy(), cells.copy()
+    path_mult = mult[cells]
+    along = np.concatenate([[0.0], np.cumsum(path_step_costs(pts, cells, xy, faces, neighbors,
+                                                             mult))])
+
+    def line(i: int, j: int):
+        walked = walk_segment(xy, faces, neighbors, mult, int(cells[i]), int(cells[j]),
+                              pts[i], pts[j], limit=float(path_mult[i:j + 1].max()))
+        if walked is None or walked[2] > along[j] - along[i] + 1e-9:
+            return None
+        return walked
+
+    out_xy = [pts[0]]
+    out_cells = [int(cells[0])]
+    i = 0
+    while i < n - 1:
+        good, good_walk = i + 1, None
+        step = 1
+        bad = None
+        while True:
+            j = min(i + 2 * step, n - 1)
+            walked = line(i, j)
+            if walked is None:
+                bad = j
+                break
+            good, good_walk = j, walked
+            if j == n - 1:
+                break
+            step *= 2
+        while bad is not None and bad - good > 1:
+            mid = (good + bad) // 2
+            walked = line(i, mid)
+            if walked is None:
+                bad = mid
+            else:
+                good, good_walk = mid, walked
+        if good_walk is None:  # the next point: the path's own step
+            out_xy.append(pts[good])
+            out_cells.append(int(cells[good]))
+        else:
+            crossed, entries, _ = good_walk
+            out_xy.extend(np.asarray(entries[k]) for k in range(len(entries)))
+            out_cells.extend(crossed)
+            out_xy.append(pts[good])
+            out_cells.append(int(cells[good]))
+        i = good
+    return np.asarray(out_xy, dtype=np.float64), np.asarray(out_cells, dtype=np.int64)
+
+
+_KERNEL = CompiledKernel("easynav.planners._navmap_shortcut_numba", "shortcut_kernel")
+
+
+def shortcut_path(
+    points: np.ndarray,
+    cells: np.ndarray,
+    xy: np.ndarray,
+    faces: np.ndarray,
+    neighbors: np.ndarray,
+    mult: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`shortcut_path_reference`'s answer, computed by the compiled twin when numba is
+    installed (the first call compiles it: a few seconds, cached on disk afterwards; it does
+    not hold the GIL). Any thread."""
+    kernel = _KERNEL.get()
+    pts = np.ascontiguousarray(np.asarray(points, dtype=np.float64)[:, :2])
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    if kernel is None or len(cells) < 3:
+        return shortcut_path_reference(pts, cells, xy, faces, neighbors, mult)
+    return kernel(pts, cells, np.ascontiguousarray(xy, dtype=np.float64),
+                  np.ascontiguousarray(faces, dtype=np.int64),
+                  np.ascontiguousarray(neighbors, dtype=np.int64),
+                  np.ascontiguousarray(mult, dtype=np.float64))
