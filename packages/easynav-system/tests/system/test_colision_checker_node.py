@@ -55,20 +55,24 @@ def _rosout(ros) -> list[str]:
     return texts
 
 
+def _active_checker(ros, params_file, runtime_factory, params):
+    # EasyNav started with the check active and ``params``: its checker and the log.
+    log = _rosout(ros)
+    rt = runtime_factory(params_file(system_params(
+        **{"controller_node.colision_checker.active": True, **params})))
+    assert rt.start(), rt.error
+    return rt.system_node.subnodes["controller_node"].colision_checker, log
+
+
 def test_checker_takes_the_robot_shape_from_robot_geometry(ros, params_file, runtime_factory):
     """robot_geometry configures the checked circle and height; the original's own copies are
     deprecated and ignored when both are set, and the whole check is deprecated (braking before
     an obstacle is the recovery system's job): each said once in the log."""
-    document = system_params(**{
+    checker, log = _active_checker(ros, params_file, runtime_factory, {
         "system_node.robot_geometry.radius": 0.45,
         "system_node.robot_geometry.height": 0.8,
-        "controller_node.colision_checker.active": True,
         "controller_node.colision_checker.robot_radius": 0.3,
     })
-    log = _rosout(ros)
-    rt = runtime_factory(params_file(document))
-    assert rt.start(), rt.error
-    checker = rt.system_node.subnodes["controller_node"].colision_checker
     assert (checker.robot_radius, checker.robot_height) == (0.45, 0.8)
     expected = [
         "controller_node.colision_checker.robot_radius is deprecated and ignored: "
@@ -82,15 +86,10 @@ def test_checker_takes_the_robot_shape_from_robot_geometry(ros, params_file, run
 
 
 def test_checker_copy_applies_where_robot_geometry_is_unset(ros, params_file, runtime_factory):
-    document = system_params(**{
-        "controller_node.colision_checker.active": True,
+    checker, log = _active_checker(ros, params_file, runtime_factory, {
         "controller_node.colision_checker.robot_radius": 0.25,
         "controller_node.colision_checker.robot_height": 1.2,
     })
-    log = _rosout(ros)
-    rt = runtime_factory(params_file(document))
-    assert rt.start(), rt.error
-    checker = rt.system_node.subnodes["controller_node"].colision_checker
     assert (checker.robot_radius, checker.robot_height) == (0.25, 1.2)
     assert ros.spin_until(lambda: any(
         "controller_node.colision_checker.robot_height = 1.2 is deprecated: set "

@@ -108,14 +108,8 @@ def walk_segment(
     return None
 
 
-def path_step_costs(
-    points: np.ndarray,
-    cells: np.ndarray,
-    xy: np.ndarray,
-    faces: np.ndarray,
-    neighbors: np.ndarray,
-    mult: np.ndarray,
-) -> np.ndarray:
+def path_step_costs(points: np.ndarray, cells: np.ndarray, xy: np.ndarray, faces: np.ndarray,
+                    neighbors: np.ndarray, mult: np.ndarray) -> np.ndarray:
     """(N-1,) the cost of each step of the path ``points`` (N, 2+) through NavCels ``cells``
     as a line: its length inside each NavCel times that NavCel's multiplier. A step the line
     walk refuses (it grazes a vertex, or skirts a third NavCel) costs its length times the
@@ -134,13 +128,8 @@ def path_step_costs(
 
 
 def shortcut_path_reference(
-    points: np.ndarray,
-    cells: np.ndarray,
-    xy: np.ndarray,
-    faces: np.ndarray,
-    neighbors: np.ndarray,
-    mult: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
+        points: np.ndarray, cells: np.ndarray, xy: np.ndarray, faces: np.ndarray,
+        neighbors: np.ndarray, mult: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The path ``points`` (N, 2+) through NavCels ``cells`` (N,), pulled straight (module
     documentation). Returns the xy points (K, 2) and their NavCels (K,), ends unchanged.
 
@@ -206,14 +195,8 @@ def shortcut_path_reference(
 _KERNEL = CompiledKernel("easynav.planners._navmap_shortcut_numba", "shortcut_kernel")
 
 
-def shortcut_path(
-    points: np.ndarray,
-    cells: np.ndarray,
-    xy: np.ndarray,
-    faces: np.ndarray,
-    neighbors: np.ndarray,
-    mult: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
+def shortcut_path(points: np.ndarray, cells: np.ndarray, xy: np.ndarray, faces: np.ndarray,
+                  neighbors: np.ndarray, mult: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`shortcut_path_reference`'s answer, computed by the compiled twin when numba is
     installed (the first call compiles it: a few seconds, cached on disk afterwards; it does
     not hold the GIL). Any thread."""
