@@ -568,3 +568,69 @@ def test_compiled_straightening_gives_the_reference_answer(seed):
         np.testing.assert_allclose(fast_xy, ref_xy, rtol=0, atol=1e-12)
         compared += 1
     assert compared >= 3
+
+
+def test_kept_straightened_path_knows_every_navcel_it_crosses():
+    """continuous_replan false keeps the path while none of its NavCels is blocked: every
+    NavCel the straightened path runs through counts, also those whose crossing points were
+    left out for being within a centimetre of another (at each vertex of a grid's diagonal)."""
+    navmap = merge(patch(0, 4, 0, 4))
+    navmap.add_layer("obstacles")
+    robot, goal = (3.53, 0.47, 0.0), (0.47, 3.53, 0.0, 2.0)
+    planner = make_planner({"continuous_replan": False})
+    nav_state = state_with(navmap, goal, robot)
+    planner.update(nav_state)
+    pts = points(nav_state.get("path", Path))
+    ts = (np.arange(50) + 0.5)[:, None] / 50  # inside each segment, off its ends (vertices)
+    samples = np.concatenate([a + ts * (b - a) for a, b in zip(pts[:-1], pts[1:], strict=True)])
+    under, _ = navmap.locate(samples)
+    assert set(under.tolist()) <= set(planner._last_crossed.tolist())
+    # Block a NavCel the path runs through but holds no point of: the path is planned again.
+    pointless = sorted(set(under.tolist()) - set(navmap.locate(pts)[0].tolist()))
+    assert pointless
+    navmap.layer("obstacles")[pointless[len(pointless) // 2]] = 254
+    planner.update(nav_state)
+    assert "path kept" not in diagnostic(nav_state).message
+    replanned = points(nav_state.get("path", Path))
+    assert pointless[len(pointless) // 2] not in navmap.locate(replanned)[0]
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_straightening_from_a_navcel_steeper_than_the_limit(compiled, monkeypatch):
+    """The robot on a NavCel steeper than max_allowed_slope_deg (its multiplier infinite: A*
+    never enters it, but starts from it): the path still keeps off the band of inflated
+    NavCels it goes round, compiled or not."""
+    from easynav.planners import navmap_shortcut
+
+    if compiled:
+        pytest.importorskip("numba")
+    else:
+        monkeypatch.setattr(navmap_shortcut._KERNEL, "_kernel", False)
+
+    def bump(x, y):
+        return np.where((np.abs(x - 0.2) < 1e-9) & (np.abs(y - 0.2) < 1e-9), 0.3, 0.0)
+
+    navmap = merge(patch(0, 3, 0, 1, bump))
+    c = navmap.centroids
+    band = (np.abs(c[:, 0] - 1.5) < 0.3) & (c[:, 1] < 0.8)
+    layer = navmap.add_layer("inflated_obstacles")
+    layer[band] = 253
+    robot, goal = (0.23, 0.21, 0.05), (2.77, 0.21, 0.0, 0.0)
+    planner, nav_state, path = plan(navmap, goal, robot, {"max_allowed_slope_deg": 45.0})
+    assert not math.isfinite(step_multipliers(layer, navmap.num_navcels, 2.0, 5.0, planner._steep(
+        navmap))[planner._last_cells[0]])
+    assert not band[planner._last_crossed].any()
+    assert len(path) > 2 and points(path)[:, 1].max() > 0.8
+
+
+def test_straightened_path_to_a_goal_on_a_vertex_ends_with_a_real_segment():
+    """A goal on a grid vertex (round coordinates): the line reaches it through the NavCels
+    round the vertex, whose entry points are the goal itself; none is left before the goal, so
+    the last pose but one faces the goal."""
+    navmap = merge(patch(0, 4, 0, 4))
+    for gx, gy in itertools.product((0.5, 1.1, 1.7, 2.3, 2.9, 3.5), (0.5, 1.2, 1.9, 2.6, 3.3)):
+        _, _, path = plan(navmap, (gx, gy, 0.0, 0.0), (0.23, 0.37, 0.0))
+        pts = points(path)
+        last = pts[-1, :2] - pts[-2, :2]
+        assert np.hypot(*last) >= 0.01, (gx, gy)
+        assert path.poses[-2].yaw == pytest.approx(math.atan2(last[1], last[0]), abs=1e-9)

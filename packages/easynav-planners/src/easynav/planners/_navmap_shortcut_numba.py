@@ -2,9 +2,10 @@
 
 Importing this module requires numba (``pip install easynav-planners[numba]``); callers go
 through :func:`easynav.planners.navmap_shortcut.shortcut_path`, which falls back to the
-reference without it. Same line walk (a vertex on the line counts as left of it), same
-criteria and the same doubling-then-halving search, float64 throughout; the output grows by
-doubling. Compiled with ``nogil``: straightening a path does not hold the GIL.
+reference without it. Same line walk (a vertex on the line counts as left of it), same criteria
+and the same doubling-then-halving search, float64 throughout (for the planner's multipliers,
+never NaN; the same answers); the output grows by doubling. Compiled with ``nogil``:
+straightening a path does not hold the GIL.
 """
 
 from __future__ import annotations
@@ -14,6 +15,34 @@ import math
 import numpy as np
 from numba import njit
 
+from easynav.planners.navmap_shortcut import END_TOLERANCE
+
+
+@njit(cache=True, nogil=True)
+def _exit(xy, faces, neighbors, cid, came_from, px, py, dx, dy):
+    exit_e = -1
+    exit_t = -np.inf
+    for e in range(3):
+        a = faces[cid, e]
+        b = faces[cid, (e + 1) % 3]
+        ax = xy[a, 0]
+        ay = xy[a, 1]
+        bx = xy[b, 0]
+        by = xy[b, 1]
+        left_a = dx * (ay - py) - dy * (ax - px) >= 0.0
+        left_b = dx * (by - py) - dy * (bx - px) >= 0.0
+        if left_a == left_b:
+            continue
+        if came_from >= 0 and neighbors[cid, e] == came_from:
+            continue
+        ex = bx - ax
+        ey = by - ay
+        t = ((ax - px) * ey - (ay - py) * ex) / (dx * ey - dy * ex)
+        if t > exit_t:
+            exit_e = e
+            exit_t = t
+    return exit_e, exit_t
+
 
 @njit(cache=True, nogil=True)
 def _walk(xy, faces, neighbors, mult, start, target, px, py, qx, qy, limit, rec_cells,
@@ -21,6 +50,8 @@ def _walk(xy, faces, neighbors, mult, start, target, px, py, qx, qy, limit, rec_
     """``(count, cost)`` of the line p -> q from NavCel ``start`` to ``target`` (count -1: no
     line). With ``rec_cells`` longer than 0, the NavCels crossed and their entry points are
     written there (count -2: not room enough, the caller tries again with more)."""
+    if not math.isfinite(mult[start]):
+        return -1, np.inf
     dx = qx - px
     dy = qy - py
     length = math.sqrt(dx * dx + dy * dy)
@@ -30,35 +61,15 @@ def _walk(xy, faces, neighbors, mult, start, target, px, py, qx, qy, limit, rec_
     cost = 0.0
     count = 0
     record = rec_cells.shape[0] > 0
-    for _ in range(1000000):
+    for _ in range(faces.shape[0] + 1):
+        exit_e, exit_t = _exit(xy, faces, neighbors, cid, came_from, px, py, dx, dy)
         if cid == target:
+            if exit_e >= 0 and exit_t < 1.0 - END_TOLERANCE:
+                return -1, np.inf
             rest = 1.0 - t_in
             if rest < 0.0:
                 rest = 0.0
             return count, cost + rest * length * mult[cid]
-        exit_e = -1
-        exit_t = -np.inf
-        for e in range(3):
-            a = faces[cid, e]
-            b = faces[cid, (e + 1) % 3]
-            ax = xy[a, 0]
-            ay = xy[a, 1]
-            bx = xy[b, 0]
-            by = xy[b, 1]
-            left_a = dx * (ay - py) - dy * (ax - px) >= 0.0
-            left_b = dx * (by - py) - dy * (bx - px) >= 0.0
-            if left_a == left_b:
-                continue
-            nb = neighbors[cid, e]
-            if came_from >= 0 and nb == came_from:
-                continue
-            ex = bx - ax
-            ey = by - ay
-            denom = dx * ey - dy * ex
-            t = ((ax - px) * ey - (ay - py) * ex) / denom
-            if t > exit_t:
-                exit_e = e
-                exit_t = t
         if exit_e < 0 or exit_t >= 1.0:
             return -1, np.inf
         nb = neighbors[cid, exit_e]
@@ -105,7 +116,7 @@ def shortcut_kernel(pts, cells, xy, faces, neighbors, mult):
         if count < 0:
             ddx = pts[k + 1, 0] - pts[k, 0]
             ddy = pts[k + 1, 1] - pts[k, 1]
-            cost = math.sqrt(ddx * ddx + ddy * ddy) * 0.5 * (mult[cells[k]] + mult[cells[k + 1]])
+            cost = math.sqrt(ddx * ddx + ddy * ddy) * min(mult[cells[k]], mult[cells[k + 1]])
         along[k + 1] = along[k] + cost
     capacity = 4 * n + 16
     out_xy = np.empty((capacity, 2))

@@ -332,19 +332,20 @@ class NavMapAStarPlanner(PathPlannerBase):
     @staticmethod
     def _straightened(navmap: NavMap, points: np.ndarray, cells: np.ndarray,
                       mult: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The path pulled straight (:func:`shortcut_path`), 3-D on its NavCels, without
-        points closer than ``MIN_POINT_SPACING`` to the one before (the ends kept)."""
+        """The path pulled straight (:func:`shortcut_path`), 3-D on its NavCels, and every
+        NavCel it crosses. Points closer than ``MIN_POINT_SPACING`` to the one kept before, or
+        to the last one, are left out (the ends kept); their NavCels are still crossed."""
         xy, crossed = shortcut_path(points, cells, navmap.vertices, navmap.faces,
                                     navmap.neighbors, mult)
         keep = np.ones(len(xy), dtype=bool)
         last = 0
         for k in range(1, len(xy) - 1):
-            if np.hypot(*(xy[k] - xy[last])) < MIN_POINT_SPACING:
+            if (np.hypot(*(xy[k] - xy[last])) < MIN_POINT_SPACING
+                    or np.hypot(*(xy[k] - xy[-1])) < MIN_POINT_SPACING):
                 keep[k] = False
             else:
                 last = k
-        xy, crossed = xy[keep], crossed[keep]
-        out = clamp_to_triangles(xy, navmap.vertices[navmap.faces[crossed]])
+        out = clamp_to_triangles(xy[keep], navmap.vertices[navmap.faces[crossed[keep]]])
         out[0], out[-1] = points[0], points[-1]
         return out, crossed
 

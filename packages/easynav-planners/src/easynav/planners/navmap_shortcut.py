@@ -8,12 +8,13 @@ barely touches. A controller slows down for every one of those turns.
 
 :func:`shortcut_path` pulls the path straight: from each kept point it jumps to the farthest
 later point it can reach by a straight line (in xy) across the mesh, when the straight line
-crosses no NavCel costlier than the costliest of the stretch of path it replaces, and costs
-no more than that stretch under the planner's own cost model (the length inside each NavCel
+crosses no NavCel costlier than the costliest of the stretch of path it replaces, and costs no
+more than that stretch under the planner's multipliers (the length in xy inside each NavCel
 times its multiplier, :func:`~easynav.planners.navmap_astar.step_multipliers`; the path's own
-steps measured the same way, :func:`path_step_costs`). So a shortcut never enters a NavCel A*
-would never enter, and never trades a detour around an inflated obstacle for a line through
-its inflation: a path that kept to free NavCels stays on free NavCels.
+steps measured the same way, :func:`path_step_costs`; A* measures its steps in 3-D, so on a ramp
+a line may cost up to 1/cos(slope) more than the stretch by A*'s measure). So a shortcut never
+enters a NavCel A* would never enter, and never trades a detour around an inflated obstacle for
+a line through its inflation: a path that kept to free NavCels stays on free NavCels.
 
 The line is followed from NavCel to NavCel through shared edges (:func:`walk_segment`), so it
 stays on the surface the path is on: floors above or below the same (x, y) are not reached,
@@ -34,9 +35,34 @@ import numpy as np
 
 from easynav.planners.compiled_kernel import CompiledKernel
 
+#: How far (in the line's parameter, 0 at p, 1 at q) the line may leave the target NavCel
+#: before q: rounding, for a q on the target's edge or vertex.
+END_TOLERANCE = 1e-9
+
 
 def _cross(ax: float, ay: float, bx: float, by: float) -> float:
     return ax * by - ay * bx
+
+
+def _exit(xy, faces, neighbors, cid, came_from, px, py, dx, dy) -> tuple[int, float]:
+    """``(edge, t)``: the edge of NavCel ``cid`` by which the line ``p + t d`` leaves it
+    (shifted right of any vertex on it), not the one towards ``came_from``; (-1, -inf) when
+    none."""
+    corners = [xy[faces[cid, k]] for k in range(3)]
+    # Side of the line of each corner: True left (or on it), False right.
+    left = [_cross(dx, dy, float(c[0]) - px, float(c[1]) - py) >= 0.0 for c in corners]
+    exit_e, exit_t = -1, -math.inf
+    for e in range(3):
+        if left[e] == left[(e + 1) % 3]:
+            continue  # the (shifted) line does not cross this edge
+        if came_from >= 0 and int(neighbors[cid, e]) == came_from:
+            continue  # the edge it came in by
+        a, b = corners[e], corners[(e + 1) % 3]
+        ex, ey = float(b[0] - a[0]), float(b[1] - a[1])
+        t = _cross(float(a[0]) - px, float(a[1]) - py, ex, ey) / _cross(dx, dy, ex, ey)
+        if t > exit_t:
+            exit_e, exit_t = e, t
+    return exit_e, exit_t
 
 
 def walk_segment(
@@ -49,7 +75,6 @@ def walk_segment(
     p: tuple[float, float],
     q: tuple[float, float],
     limit: float = math.inf,
-    max_steps: int = 100000,
 ) -> tuple[list[int], list[tuple[float, float]], float] | None:
     """Follow the straight line from ``p`` (in NavCel ``start``) to ``q`` (in NavCel
     ``target``) across shared edges.
@@ -58,42 +83,33 @@ def walk_segment(
     ``neighbors`` (M, 3) (``neighbors[c, e]`` across edge ``faces[c, e] -> faces[c, (e+1) %
     3]``, -1 at a border), ``mult`` (M,) step multipliers. Returns the NavCels crossed after
     ``start`` (``target`` last), the points where the line enters each of them, and the line's
-    cost (each length inside a NavCel times its multiplier, ``start``'s included); None when the
-    line leaves the mesh, enters a NavCel of infinite multiplier or of a multiplier above
-    ``limit``, or ends elsewhere than ``target``.
+    cost (each length inside a NavCel times its multiplier, ``start``'s included); None when
+    ``start`` or a NavCel entered has an infinite multiplier or one above ``limit``, or the line
+    leaves the mesh, or does not end in ``target`` (``q`` in another NavCel, or beyond
+    ``target``).
 
     A line through a vertex (every 45-degree line between centroids of a grid mesh is one) is
     walked as if shifted an infinitesimal amount to the right of it: a vertex on the line
     counts as left of it. The NavCels round the vertex on that side are then crossed (with no
-    length inside them) and must be enterable too.
+    length inside them) and must be enterable too. Likewise a line along an edge runs in the
+    NavCel on its right and is charged there.
     """
+    if not math.isfinite(float(mult[start])):
+        return None
     px, py = float(p[0]), float(p[1])
     dx, dy = float(q[0]) - px, float(q[1]) - py
-    length = math.hypot(dx, dy)
+    length = math.sqrt(dx * dx + dy * dy)  # as the compiled twin: the same rounding
     cid, came_from = int(start), -1
     t_in = 0.0
     cost = 0.0
     cells: list[int] = []
     entries: list[tuple[float, float]] = []
-    for _ in range(max_steps):
+    for _ in range(faces.shape[0] + 1):  # a line crosses a NavCel once at most
+        exit_e, exit_t = _exit(xy, faces, neighbors, cid, came_from, px, py, dx, dy)
         if cid == target:
+            if exit_e >= 0 and exit_t < 1.0 - END_TOLERANCE:
+                return None  # the line leaves the target before q
             return cells, entries, cost + max(0.0, 1.0 - t_in) * length * float(mult[cid])
-        corners = [xy[faces[cid, k]] for k in range(3)]
-        # Side of the line of each corner: True left (or on it), False right.
-        left = [_cross(dx, dy, float(c[0]) - px, float(c[1]) - py) >= 0.0 for c in corners]
-        exit_e, exit_t = -1, -math.inf
-        for e in range(3):
-            if left[e] == left[(e + 1) % 3]:
-                continue  # the (shifted) line does not cross this edge
-            nb = int(neighbors[cid, e])
-            if came_from >= 0 and nb == came_from:
-                continue  # the edge it came in by
-            a, b = corners[e], corners[(e + 1) % 3]
-            ex, ey = float(b[0] - a[0]), float(b[1] - a[1])
-            denom = _cross(dx, dy, ex, ey)
-            t = _cross(float(a[0]) - px, float(a[1]) - py, ex, ey) / denom
-            if t > exit_t:
-                exit_e, exit_t = e, t
         if exit_e < 0 or exit_t >= 1.0:
             return None  # q lies in this NavCel, which is not the target
         nb = int(neighbors[cid, exit_e])
@@ -111,9 +127,11 @@ def walk_segment(
 def path_step_costs(points: np.ndarray, cells: np.ndarray, xy: np.ndarray, faces: np.ndarray,
                     neighbors: np.ndarray, mult: np.ndarray) -> np.ndarray:
     """(N-1,) the cost of each step of the path ``points`` (N, 2+) through NavCels ``cells``
-    as a line: its length inside each NavCel times that NavCel's multiplier. A step the line
-    walk refuses (it grazes a vertex, or skirts a third NavCel) costs its length times the
-    mean of its two NavCels' multipliers."""
+    as a line: its length inside each NavCel times that NavCel's multiplier. A step the walk
+    refuses (it ends on an edge or a vertex of the next NavCel, starts in a NavCel of infinite
+    multiplier, or crosses a third NavCel of infinite multiplier) costs its length times the
+    smaller of its two NavCels' multipliers: no more than the step costs, so that a shortcut
+    compared with it is never costlier."""
     pts = np.asarray(points, dtype=np.float64)[:, :2]
     out = np.empty(len(cells) - 1)
     for k in range(len(cells) - 1):
@@ -122,8 +140,9 @@ def path_step_costs(points: np.ndarray, cells: np.ndarray, xy: np.ndarray, faces
         if walked is not None:
             out[k] = walked[2]
         else:
-            out[k] = float(np.hypot(*(pts[k + 1] - pts[k]))) * 0.5 * float(
-                mult[cells[k]] + mult[cells[k + 1]])
+            ddx, ddy = float(pts[k + 1, 0] - pts[k, 0]), float(pts[k + 1, 1] - pts[k, 1])
+            out[k] = math.sqrt(ddx * ddx + ddy * ddy) * min(float(mult[cells[k]]),
+                                                            float(mult[cells[k + 1]]))
     return out
 
 
