@@ -634,3 +634,29 @@ def test_straightened_path_to_a_goal_on_a_vertex_ends_with_a_real_segment():
         last = pts[-1, :2] - pts[-2, :2]
         assert np.hypot(*last) >= 0.01, (gx, gy)
         assert path.poses[-2].yaw == pytest.approx(math.atan2(last[1], last[0]), abs=1e-9)
+
+
+def test_straightened_path_from_inside_the_inflation_leaves_it_as_a_star_does():
+    """A robot against the corner of a block, inside its inflation (as after a collision):
+    the path leaves the inflation the way A* does before any shortcut, and once on free
+    NavCels it stays on them; a line from the robot, allowed the robot's own cost all along,
+    ran past the corner inside the inflation and kept the robot against it."""
+    navmap = merge(patch(0, 6, 0, 6))
+    c = navmap.centroids
+    block = (c[:, 0] > 3.0) & (c[:, 0] < 5.0) & (c[:, 1] > 1.0) & (c[:, 1] < 4.0)
+    d = np.hypot(np.clip(c[:, 0], 3.0, 5.0) - c[:, 0], np.clip(c[:, 1], 1.0, 4.0) - c[:, 1])
+    costs = np.where(block, 254, np.where(d <= 0.3, 253, np.where(
+        d <= 0.6, 253 * np.exp(-5 * (d - 0.3)), 0))).astype(np.uint8)
+    navmap.set_layer("inflated_obstacles", costs, np.uint8)
+    robot = (3.1, 4.28, 0.0)  # against the block's north face, by its north-west corner
+    goal = (1.0, 1.5, 0.0, 0.0)  # the straight line passes 0.1 m from that corner
+    planner, _, path = plan(navmap, goal, robot)
+    crossed = planner._last_crossed
+    free = np.flatnonzero(costs[crossed] == 0)
+    assert len(free) and (costs[crossed[free[0]:]] == 0).all()
+    # No nearer the corner than A*'s own path (the line from the robot passed 0.1 m from it).
+    pts = points(path)
+    star = navmap.centroids[planner._last_cells]
+    assert np.hypot(pts[:, 0] - 3.0, pts[:, 1] - 4.0).min() >= np.hypot(
+        star[:, 0] - 3.0, star[:, 1] - 4.0).min() - 0.05
+    assert np.hypot(pts[:, 0] - 3.0, pts[:, 1] - 4.0).min() > 0.2

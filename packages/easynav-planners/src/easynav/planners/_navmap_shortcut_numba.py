@@ -118,6 +118,17 @@ def shortcut_kernel(pts, cells, xy, faces, neighbors, mult):
             ddy = pts[k + 1, 1] - pts[k, 1]
             cost = math.sqrt(ddx * ddx + ddy * ddy) * min(mult[cells[k]], mult[cells[k + 1]])
         along[k + 1] = along[k] + cost
+    lowest = np.inf
+    for k in range(n):
+        if math.isfinite(mult[cells[k]]) and mult[cells[k]] < lowest:
+            lowest = mult[cells[k]]
+    first = -1
+    last = -1
+    for k in range(n):
+        if mult[cells[k]] <= lowest:
+            if first < 0:
+                first = k
+            last = k
     capacity = 4 * n + 16
     out_xy = np.empty((capacity, 2))
     out_cells = np.empty(capacity, dtype=np.int64)
@@ -131,8 +142,8 @@ def shortcut_kernel(pts, cells, xy, faces, neighbors, mult):
         found = False
         step = 1
         bad = -1
-        while True:
-            j = min(i + 2 * step, n - 1)
+        while first <= i < last:
+            j = min(i + 2 * step, last)
             ok, _ = _line_ok(xy, faces, neighbors, mult, pts, cells, along, i, j, no_cells,
                              no_xy)
             if not ok:
@@ -140,7 +151,7 @@ def shortcut_kernel(pts, cells, xy, faces, neighbors, mult):
                 break
             good = j
             found = True
-            if j == n - 1:
+            if j == last:
                 break
             step *= 2
         while bad >= 0 and bad - good > 1:

@@ -155,7 +155,11 @@ def shortcut_path_reference(
     From each kept point, the farthest later point reachable by a line no costlier than the
     path is found by doubling the jump until a line fails, then halving between the last
     success and the failure (a line that fails in between is not looked for: the result is
-    straighter, not necessarily the straightest).
+    straighter, not necessarily the straightest). A path that starts inside an obstacle's
+    inflation (a robot against a wall) keeps A*'s own steps until its first NavCel of the
+    path's lowest multiplier, and likewise from its last one to a goal inside one: a line
+    from the robot would be allowed NavCels as costly as the robot's own all along, and
+    could run past the obstacle the robot has to get away from.
 
     Pure Python: the readable version the tests check the compiled one against."""
     pts = np.asarray(points, dtype=np.float64)[:, :2]
@@ -174,6 +178,10 @@ def shortcut_path_reference(
             return None
         return walked
 
+    # A path that starts (or ends) inside an obstacle's inflation keeps A*'s own way out (in):
+    # shortcuts run between its first and last NavCels of the path's lowest multiplier only.
+    lowest = np.flatnonzero(path_mult <= path_mult[np.isfinite(path_mult)].min())
+    first, last = int(lowest[0]), int(lowest[-1])
     out_xy = [pts[0]]
     out_cells = [int(cells[0])]
     i = 0
@@ -181,14 +189,14 @@ def shortcut_path_reference(
         good, good_walk = i + 1, None
         step = 1
         bad = None
-        while True:
-            j = min(i + 2 * step, n - 1)
+        while first <= i < last:
+            j = min(i + 2 * step, last)
             walked = line(i, j)
             if walked is None:
                 bad = j
                 break
             good, good_walk = j, walked
-            if j == n - 1:
+            if j == last:
                 break
             step *= 2
         while bad is not None and bad - good > 1:
