@@ -29,8 +29,7 @@ COMMON_PARAMETERS = (
     Param("package", "", "package holding the map files (empty: the file parameters are paths)"),
     Param(
         "occmap_path_file", "",
-        "map_server YAML whose occupied cells are extruded to wall_height (its resolution "
-        "replaces resolution)",
+        "map_server YAML whose occupied cells are extruded to wall_height (see resolution)",
     ),
     Param("wall_height", 1.0, "height the occupied cells of occmap_path_file are extruded to",
           "m", gt=0.0),
