@@ -29,8 +29,9 @@ COST_LAYERS = ("inflated_obstacles", "obstacles")
 #: The original's smoothing: 5 Laplacian iterations with weight 0.4.
 SMOOTHING_ITERATIONS = 5
 SMOOTHING_ALPHA = 0.4
-#: Points of a straightened path closer than this (m, xy) to the one before are dropped: the
-#: line's crossings of NavCel edges near a vertex, whose heading would be noise.
+#: Points of a straightened path closer than this (m, xy) to the one kept before, or to the
+#: last, are left out: the line's crossings of NavCel edges near a vertex, whose heading would
+#: be noise.
 MIN_POINT_SPACING = 0.01
 #: Farthest (m, 3-D) the robot may be from the nearest NavCel centroid when no NavCel lies
 #: under it (localisation noise at the edge of the mesh); farther, it is off the NavMap.
@@ -134,8 +135,9 @@ class NavMapAStarPlanner(PathPlannerBase):
     NavCels (:func:`~easynav.planners.navmap_shortcut.shortcut_path`): on a mesh made from a
     grid, A*'s path across the grid's other diagonal is a staircase of right-angle turns, each
     of which slows the controller down. A line replaces a stretch of path only where it crosses
-    no NavCel costlier than the stretch's costliest, and costs no more; its points are where it
-    crosses NavCel edges, z on the surface. False: the original's 5 rounds of Laplacian
+    no NavCel costlier than the stretch's costliest, and costs no more (a path from inside an
+    obstacle's inflation keeps A*'s way out first); its points are where it crosses NavCel
+    edges, z on the surface. False: the original's 5 rounds of Laplacian
     smoothing (weight 0.4), each point clamped to its own NavCel (:func:`smooth_on_navcels`),
     ends fixed. Poses are 3-D: each facing the next in xy, the last with the goal's yaw. When
     the robot is already on the goal's NavCel the path is the goal's point alone.
