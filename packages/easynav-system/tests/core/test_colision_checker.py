@@ -109,3 +109,5 @@ def test_parameters_are_declared_with_the_original_names_and_defaults():
         )
     with pytest.raises(ValueError, match="robot_radius"):
         ColisionChecker(robot_radius=math.nan)
+    with pytest.raises(ValueError, match="robot_height = -0.5"):
+        ColisionChecker(robot_height=-0.5)

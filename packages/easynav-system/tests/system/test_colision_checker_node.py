@@ -91,9 +91,24 @@ def test_checker_copy_applies_where_robot_geometry_is_unset(ros, params_file, ru
         "controller_node.colision_checker.robot_height": 1.2,
     })
     assert (checker.robot_radius, checker.robot_height) == (0.25, 1.2)
-    assert ros.spin_until(lambda: any(
+    expected = [
+        "controller_node.colision_checker.robot_radius = 0.25 is deprecated: set "
+        "system_node.robot_geometry.radius instead",
         "controller_node.colision_checker.robot_height = 1.2 is deprecated: set "
-        "system_node.robot_geometry.height instead" in t for t in log), timeout=5.0)
+        "system_node.robot_geometry.height instead",
+    ]
+    assert ros.spin_until(lambda: all(any(e in t for t in log) for e in expected), timeout=5.0)
+
+
+def test_checker_shape_defaults_to_robot_geometry_and_takes_a_point_robot(
+        ros, params_file, runtime_factory):
+    """Neither set: robot_geometry's defaults (0.3 m, 0.5 m; the original's copy said 0.35 m).
+    robot_geometry's legal 0 (a point robot) is the check's too."""
+    checker, _ = _active_checker(ros, params_file, runtime_factory, {})
+    assert (checker.robot_radius, checker.robot_height) == (0.3, 0.5)
+    checker, _ = _active_checker(ros, params_file, runtime_factory,
+                                 {"system_node.robot_geometry.radius": 0.0})
+    assert checker.robot_radius == 0.0
 
 
 def test_bad_value_fails_configuration_naming_it(params_file, runtime_factory):

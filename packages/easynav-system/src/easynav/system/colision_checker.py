@@ -69,7 +69,8 @@ class ColisionChecker:
     original stopped it for any point inside its radius. Reversing is checked behind.
 
     Thread contract: immutable after construction; any thread. Exceptions: ``ValueError`` for
-    non-positive radius, height, deceleration or leaf size, or a negative margin.
+    a negative radius or height, a non-positive deceleration or leaf size, or a negative
+    margin.
     """
 
     def __init__(
@@ -81,11 +82,15 @@ class ColisionChecker:
         z_min_filter: float = 0.0,
         downsample_leaf_size: float = 0.1,
     ) -> None:
-        for name, value in (("robot_radius", robot_radius), ("robot_height", robot_height),
-                            ("brake_acc", brake_acc),
+        for name, value in (("brake_acc", brake_acc),
                             ("downsample_leaf_size", downsample_leaf_size)):
             if not (math.isfinite(value) and value > 0.0):
                 raise ValueError(f"colision_checker.{name} = {value}: must be finite and > 0")
+        # The robot's shape comes from robot_geometry, where 0 is legal (a point robot; no
+        # height: nothing to check).
+        for name, value in (("robot_radius", robot_radius), ("robot_height", robot_height)):
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ValueError(f"colision_checker.{name} = {value}: must be finite and >= 0")
         if not (math.isfinite(safety_margin) and safety_margin >= 0.0):
             raise ValueError(f"colision_checker.safety_margin = {safety_margin}: must be >= 0")
         self.robot_radius = float(robot_radius)
