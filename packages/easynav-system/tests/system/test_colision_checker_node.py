@@ -64,40 +64,41 @@ def _active_checker(ros, params_file, runtime_factory, params):
     return rt.system_node.subnodes["controller_node"].colision_checker, log
 
 
-def test_checker_takes_the_robot_shape_from_robot_geometry(ros, params_file, runtime_factory):
-    """robot_geometry configures the checked circle and height; the original's own copies are
-    deprecated and ignored when both are set, and the whole check is deprecated (braking before
-    an obstacle is the recovery system's job): each said once in the log."""
-    checker, log = _active_checker(ros, params_file, runtime_factory, {
-        "system_node.robot_geometry.radius": 0.45,
-        "system_node.robot_geometry.height": 0.8,
-        "controller_node.colision_checker.robot_radius": 0.3,
-    })
-    assert (checker.robot_radius, checker.robot_height) == (0.45, 0.8)
-    expected = [
-        "controller_node.colision_checker.robot_radius is deprecated and ignored: "
-        "system_node.robot_geometry.radius = 0.45 takes precedence",
-        "controller_node.colision_checker.active is deprecated: braking before an obstacle is "
-        "the recovery system's job",
-    ]
+@pytest.mark.parametrize("params, shape, expected", [
+    pytest.param(
+        {"system_node.robot_geometry.radius": 0.45, "system_node.robot_geometry.height": 0.8,
+         "controller_node.colision_checker.robot_radius": 0.3},
+        (0.45, 0.8),
+        ["controller_node.colision_checker.robot_radius is deprecated and ignored: "
+         "system_node.robot_geometry.radius = 0.45 takes precedence"],
+        id="robot_geometry wins",
+    ),
+    pytest.param(
+        {"controller_node.colision_checker.robot_radius": 0.25,
+         "controller_node.colision_checker.robot_height": 1.2},
+        (0.25, 1.2),
+        ["controller_node.colision_checker.robot_radius = 0.25 is deprecated: set "
+         "system_node.robot_geometry.radius instead",
+         "controller_node.colision_checker.robot_height = 1.2 is deprecated: set "
+         "system_node.robot_geometry.height instead"],
+        id="the copies where robot_geometry is unset",
+    ),
+])
+def test_checker_takes_the_robot_shape_from_robot_geometry(ros, params_file, runtime_factory,
+                                                           params, shape, expected):
+    """robot_geometry configures the checked circle and height; the original's own copies
+    still apply where it does not, are ignored where it does, and the whole check is
+    deprecated (braking before an obstacle is the recovery system's job): each said once in
+    the log."""
+    checker, log = _active_checker(ros, params_file, runtime_factory, params)
+    assert (checker.robot_radius, checker.robot_height) == shape
+    expected = [*expected, "controller_node.colision_checker.active is deprecated: braking "
+                "before an obstacle is the recovery system's job"]
     assert ros.spin_until(lambda: all(any(e in t for t in log) for e in expected), timeout=5.0)
-    assert [sum(e in t for t in log) for e in expected] == [1, 1]
-    assert not any("robot_height" in t for t in log)
-
-
-def test_checker_copy_applies_where_robot_geometry_is_unset(ros, params_file, runtime_factory):
-    checker, log = _active_checker(ros, params_file, runtime_factory, {
-        "controller_node.colision_checker.robot_radius": 0.25,
-        "controller_node.colision_checker.robot_height": 1.2,
-    })
-    assert (checker.robot_radius, checker.robot_height) == (0.25, 1.2)
-    expected = [
-        "controller_node.colision_checker.robot_radius = 0.25 is deprecated: set "
-        "system_node.robot_geometry.radius instead",
-        "controller_node.colision_checker.robot_height = 1.2 is deprecated: set "
-        "system_node.robot_geometry.height instead",
-    ]
-    assert ros.spin_until(lambda: all(any(e in t for t in log) for e in expected), timeout=5.0)
+    assert [sum(e in t for t in log) for e in expected] == [1] * len(expected)
+    copies = [name for name in ("robot_radius", "robot_height")
+              if f"controller_node.colision_checker.{name}" in params]
+    assert all(any(c in t for c in copies) for t in log if "colision_checker.robot_" in t)
 
 
 def test_checker_shape_defaults_to_robot_geometry_and_takes_a_point_robot(
