@@ -139,41 +139,41 @@ def shortcut_kernel(pts, cells, xy, faces, neighbors, mult):
     i = 0
     while i < n - 1:
         good = i + 1
+        good_limit = np.inf
         found = False
         step = 1
         bad = -1
         while first <= i < last:
             j = min(i + 2 * step, last)
-            ok, _ = _line_ok(xy, faces, neighbors, mult, pts, cells, along, i, j, no_cells,
-                             no_xy)
+            ok, limit = _line_ok(xy, faces, neighbors, mult, pts, cells, along, i, j, no_cells,
+                                 no_xy)
             if not ok:
                 bad = j
                 break
             good = j
+            good_limit = limit
             found = True
             if j == last:
                 break
             step *= 2
         while bad >= 0 and bad - good > 1:
             mid = (good + bad) // 2
-            ok, _ = _line_ok(xy, faces, neighbors, mult, pts, cells, along, i, mid, no_cells,
-                             no_xy)
+            ok, limit = _line_ok(xy, faces, neighbors, mult, pts, cells, along, i, mid,
+                                 no_cells, no_xy)
             if ok:
                 good = mid
+                good_limit = limit
                 found = True
             else:
                 bad = mid
         if found:
-            limit = -np.inf
-            for k in range(i, good + 1):
-                if mult[cells[k]] > limit:
-                    limit = mult[cells[k]]
-            room = 64
+            room = 64  # a first guess at the number of crossings
             while True:  # record the crossings, with room enough for them
                 rec_cells = np.empty(room, dtype=np.int64)
                 rec_xy = np.empty((room, 2))
                 count, _ = _walk(xy, faces, neighbors, mult, cells[i], cells[good], pts[i, 0],
-                                 pts[i, 1], pts[good, 0], pts[good, 1], limit, rec_cells, rec_xy)
+                                 pts[i, 1], pts[good, 0], pts[good, 1], good_limit, rec_cells,
+                                 rec_xy)
                 if count != -2:
                     break
                 room *= 4
