@@ -24,10 +24,13 @@ from easynav.maps.gridmap import GridMap
 from easynav.planners.gridmap.gridmap_astar_planner import GridMapAStarPlanner
 from easynav.planners.gridmap.gridmap_rrtstar_planner import GridMapRRTStarPlanner
 from easynav.planners.gridmap.terrain import (
+    MARGIN_COST_FACTOR,
+    body_cost_factors,
     cell_cost_factors,
     may_reach,
     slope_of_move,
     steep_cells,
+    steep_within,
     terrain_regions,
 )
 from easynav.planners.gridmap.terrain_astar import astar, dijkstra_costs
@@ -328,8 +331,9 @@ def test_rrtstar_keeps_its_path_while_the_robot_follows_it():
     planner.update(nav_state)
     first = _poses(nav_state)
     assert len(first) > 10
-    # Along the path, and 0.4 m beside it (max_lateral_deviation 0.5): the same path.
-    x, y, yaw = first[len(first) // 2]
+    # Along the path, and 0.4 m beside it (max_lateral_deviation 0.5): the same path (a
+    # quarter of the way, on open ground: half way is the ridge's gap, 0.7 m beside it the wall).
+    x, y, yaw = first[len(first) // 4]
     for robot in ((x, y), (x - 0.4 * math.sin(yaw), y + 0.4 * math.cos(yaw))):
         _move_robot(nav_state, *robot)
         planner.update(nav_state)
@@ -436,3 +440,82 @@ def test_astar_margin_takes_the_radius_of_robot_geometry(caplog):
     assert "p.robot_radius is deprecated and ignored" in caplog.text
     assert astar_planner({"robot_radius": 0.2}, RobotGeometry()).robot_radius() == 0.2
     assert astar_planner({}, RobotGeometry()).robot_radius() == 0.3  # the original's default
+
+
+def _margin_cells_crossed(grid, path, radius, robot):
+    """The cells within ``radius`` of steep terrain (centre to centre) a path crosses (sampled
+    every 1/8 cell), leaving out those within ``radius`` plus a cell of ``robot``."""
+    margin = cell_cost_factors(grid, math.radians(LIMIT_DEG), radius) == MARGIN_COST_FACTOR
+    points = np.array([(p.x, p.y) for p in path.poses])
+    crossed = set()
+    for a, b in itertools.pairwise(points):
+        n = max(1, math.ceil(math.hypot(*(b - a)) / (grid.resolution / 8)))
+        t = np.linspace(0, 1, n + 1)[:, None]
+        for x, y in a + t * (b - a):
+            ix, iy = (int(v) for v in grid.world_to_cell(x, y))
+            if margin[iy, ix] and math.hypot(x - robot[0], y - robot[1]) > radius + grid.resolution:
+                crossed.add((ix, iy))
+    return crossed
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_rrtstar_paths_keep_the_robots_body_off_steep_terrain(seed):
+    # Priced rather than closed, the margin was cut through wherever that was shorter: on the
+    # campus, RRT* paths rounded buildings with 0.01 m between the robot and the wall.
+    grid = ridge_world()
+    for start, goal in (((1.0, 1.0), (7.0, 1.0)), ((1.0, 5.5), (7.0, 5.5)),
+                        ((3.0, 0.6), (6.0, 5.7))):
+        nav_state = state_with(grid, start, (*goal, 0.0))
+        make_planner(GridMapRRTStarPlanner, {"seed": seed, "max_iters": 1500,
+                                             "max_allowed_slope_deg": LIMIT_DEG}).update(nav_state)
+        path = nav_state.get("path", Path)
+        assert len(path) > 1, nav_state.get("diagnostics.path", DiagnosticStatus).message
+        assert not _margin_cells_crossed(grid, path, 0.3, start), (start, goal)
+
+
+def test_rrtstar_leaves_the_margin_it_starts_in_and_refuses_a_goal_inside_it():
+    grid = ridge_world()
+    start = (3.6, 1.0)  # 0.2 m from the wall's foot (x 3.8): the robot's circle touches it
+    assert cell_cost_factors(grid, math.radians(LIMIT_DEG), 0.3)[
+        tuple(int(v) for v in reversed(grid.world_to_cell(*start)))] == MARGIN_COST_FACTOR
+    nav_state = state_with(grid, start, (1.0, 5.5, 0.0))
+    planner = make_planner(GridMapRRTStarPlanner,
+                           {"max_iters": 1500, "max_allowed_slope_deg": LIMIT_DEG})
+    planner.update(nav_state)
+    path = nav_state.get("path", Path)
+    assert len(path) > 1 and not _margin_cells_crossed(grid, path, 0.3, start)
+    # A goal the robot's circle cannot reach without touching the wall: refused, saying so.
+    nav_state = state_with(grid, (1.0, 5.5), (3.6, 1.0, 0.0))
+    planner.update(nav_state)
+    reason = ("goal (3.60, 1.00) is within the robot's radius (0.30 m) of terrain steeper than "
+              "30 deg")
+    assert nav_state.get("diagnostics.path", DiagnosticStatus).message == reason
+    assert planner.take_goal_rejection() == reason
+
+
+def test_body_cost_factors_close_the_margin_except_around_the_robot():
+    grid = ridge_world()
+    limit = math.radians(LIMIT_DEG)
+    priced = cell_cost_factors(grid, limit, 0.3)
+    robot = (36, 10)  # (3.65, 1.05): in the margin of the wall's foot
+    factors = body_cost_factors(grid, limit, 0.3, robot)
+    steep = steep_cells(grid, limit)
+    assert np.isinf(factors[steep]).all()
+    assert (factors[priced == 1.0] == 1.0).all()
+    margin = priced == MARGIN_COST_FACTOR
+    iy, ix = np.nonzero(margin)
+    near = np.hypot(ix - robot[0], iy - robot[1]) <= 0.3 / grid.resolution + 1.0 + 1e-9
+    assert near.any() and (~near).any()
+    assert (factors[iy[near], ix[near]] == MARGIN_COST_FACTOR).all()
+    assert np.isinf(factors[iy[~near], ix[~near]]).all()
+
+
+def test_steep_within_is_the_margin_rule_for_one_cell():
+    grid = ridge_world()
+    limit = math.radians(LIMIT_DEG)
+    for radius in (0.0, 0.25, 0.3):
+        factors = cell_cost_factors(grid, limit, radius)
+        h, w = grid.shape
+        within = np.array([[steep_within(grid, ix, iy, radius, limit) for ix in range(w)]
+                           for iy in range(h)])
+        assert (within == (factors > 1.0)).all(), radius

@@ -1,5 +1,6 @@
 """The GridMap stack end to end on the uneven world (issue #22): GridmapMapsManager on the
-world's elevation map, GridMapAStarPlanner under its 25 deg slope limit, the fusion localizer
+world's elevation map, GridMapAStarPlanner (or GridMapRRTStarPlanner, the file's alternative)
+under its 25 deg slope limit, the fusion localizer
 outdoors. The straight legs cross a 45 deg rock and a 35 deg bank the robot cannot climb (it
 would stop, a collision with the slope); the run must reach every waypoint (one on the plateau,
 by its 15 deg ramp) with no collision, and the ground under the robot must never have been
@@ -26,13 +27,17 @@ pytestmark = [pytest.mark.slow, pytest.mark.ros, pytest.mark.timeout(600)]
 PARAMS = Path(__file__).resolve().parents[3] / "params" / "gridmap.uneven.params.yaml"
 
 
-def test_gridmap_stack_crosses_the_uneven_world_within_its_slope_limit(tmp_path):
+@pytest.mark.parametrize("planner_alias", ["astar", "rrtstar"])
+def test_gridmap_stack_crosses_the_uneven_world_within_its_slope_limit(planner_alias, tmp_path):
     if not PARAMS.is_file():
         pytest.skip("the repository's params/ is not here")
     params = yaml.safe_load(PARAMS.read_text())
     planner = params["planner_node"]["ros__parameters"]
-    limit_deg = planner[planner["planner_types"][0]]["max_allowed_slope_deg"]
-    mission = MissionRun.run(tmp_path, "uneven", PARAMS, timeout=500.0, speed_up=2.0,
+    planner["planner_types"] = [planner_alias]  # the file's A*, or its RRT* alternative
+    limit_deg = planner[planner_alias]["max_allowed_slope_deg"]
+    params_file = tmp_path / "gridmap.uneven.params.yaml"
+    params_file.write_text(yaml.safe_dump(params, sort_keys=False))
+    mission = MissionRun.run(tmp_path, "uneven", params_file, timeout=500.0, speed_up=2.0,
                              picture="uneven.png")
     report = mission.report
     assert mission.code == 0, report

@@ -14,7 +14,13 @@ from easynav.core.types import Header, Odometry, Path
 from easynav.maps.gridmap import GridMap
 from easynav.maps.gridmap.keys import GRIDMAP
 from easynav.planners.gridmap.gridmap_planner_base import GridMapPlannerBase, yaws_along
-from easynav.planners.gridmap.terrain import cell_cost_factors, may_reach, terrain_regions
+from easynav.planners.gridmap.terrain import (
+    body_cost_factors,
+    cell_is_steep,
+    may_reach,
+    steep_within,
+    terrain_regions,
+)
 from easynav.planners.gridmap.terrain_astar import astar
 from easynav.planners.gridmap.terrain_rrtstar import (
     RRTStarSettings,
@@ -52,8 +58,10 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
     """RRT* over the elevation map, never on or across a slope above the limit; seeded.
 
     Parameters: :attr:`PARAMETERS`. Segments obey the slope rules of
-    :mod:`~easynav.planners.gridmap.terrain_rrtstar`; cells within the robot's radius
-    (``system_node.robot_geometry.radius``) of steep terrain cost more. Before sampling, the goal
+    :mod:`~easynav.planners.gridmap.terrain_rrtstar`, and never cross a cell within the robot's
+    radius (``system_node.robot_geometry.radius``) of steep terrain, except around the robot
+    itself, so that a robot there can leave (:func:`~easynav.planners.gridmap.terrain.
+    body_cost_factors`). Before sampling, the goal
     is checked to be reachable at all (:func:`~easynav.planners.gridmap.terrain.may_reach`, then
     an A* search over the same rules), so an unreachable goal is reported without sampling
     ``max_iters`` times. The tree's path is shortened (each shortcut no dearer and within
@@ -140,18 +148,37 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
             self._kept = self._planned
         self._planned = None
 
+    def static_goal_problem(self, nav_state: NavState, gx: float, gy: float,
+                            goal_text: str) -> str | None:
+        """:meth:`GridMapPlannerBase.static_goal_problem`, and a goal within the robot's radius
+        of steep terrain (its paths never go there: the robot would overlap it)."""
+        problem = super().static_goal_problem(nav_state, gx, gy, goal_text)
+        grid = nav_state.get(GRIDMAP) if nav_state.has(GRIDMAP) else None
+        if problem is not None or not isinstance(grid, GridMap):
+            return problem
+        radius = self.get_robot_geometry().radius
+        limit_deg = self.params.max_allowed_slope_deg
+        ix, iy = (int(v) for v in grid.world_to_cell(gx, gy))
+        if steep_within(grid, ix, iy, radius, math.radians(limit_deg)):
+            return (f"{goal_text} is within the robot's radius ({radius:.2f} m) of terrain "
+                    f"steeper than {limit_deg:g} deg")
+        return None
+
     def plan(self, grid: GridMap, start: tuple[float, float],
              goal: tuple[float, float, float]) -> PlanResult:
         """RRT* from ``start`` to ``goal`` on ``grid`` (reads the parameters now)."""
         p = self.params
         max_slope = math.radians(p.max_allowed_slope_deg)
-        margin = self.get_robot_geometry().radius
-        factors = cell_cost_factors(grid, max_slope, margin)
+        radius = self.get_robot_geometry().radius
         sx, sy = (int(v) for v in grid.world_to_cell(*start))
         gx, gy = (int(v) for v in grid.world_to_cell(goal[0], goal[1]))
+        factors = body_cost_factors(grid, max_slope, radius, (sx, sy))
         if math.isinf(factors[gy, gx]):
-            return PlanResult(reason=f"the goal is on terrain steeper than "
-                                     f"{p.max_allowed_slope_deg:g} deg or unknown")
+            if cell_is_steep(grid, gx, gy, max_slope):
+                return PlanResult(reason=f"the goal is on terrain steeper than "
+                                         f"{p.max_allowed_slope_deg:g} deg or unknown")
+            return PlanResult(reason=f"the robot's circle there ({radius:.2f} m) overlaps "
+                                     f"terrain steeper than {p.max_allowed_slope_deg:g} deg")
         # Reachable at all? The regions answer "no" for a goal walled off (inside a building:
         # 5 s of A* over every cell the robot reaches on the campus, 2 ms here); A* answers the
         # rest as a Dijkstra from the start would, exploring towards the goal only (the
@@ -160,7 +187,8 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
             grid, (sx, sy), (gx, gy), max_slope, factors=factors
         ) is None:
             return PlanResult(reason=f"unreachable without slopes above "
-                                     f"{p.max_allowed_slope_deg:g} deg")
+                                     f"{p.max_allowed_slope_deg:g} deg or passages narrower "
+                                     f"than the robot ({2.0 * radius:.2f} m)")
         settings = RRTStarSettings(
             max_iters=p.max_iters, step_size=p.step_size, neighbor_radius=p.neighbor_radius,
             goal_bias=p.goal_bias, goal_threshold=p.goal_threshold,

@@ -55,6 +55,44 @@ def cell_cost_factors(grid: GridMap, max_slope_rad: float, margin: float) -> np.
     return factors
 
 
+def steep_within(grid: GridMap, ix: int, iy: int, radius: float, max_slope_rad: float) -> bool:
+    """True when a steep cell (:func:`steep_cells`) lies within ``radius`` of the cell
+    ``(ix, iy)`` (in bounds), centre to centre: the margin rule of :func:`cell_cost_factors`,
+    for one cell without the whole map."""
+    r = int(math.floor(radius / grid.resolution + _EPS))
+    h, w = grid.shape
+    y0, y1, x0, x1 = max(iy - r, 0), min(iy + r + 1, h), max(ix - r, 0), min(ix + r + 1, w)
+    z = grid.elevation[y0:y1, x0:x1]
+    slope = grid.layer("slope")[y0:y1, x0:x1]
+    with np.errstate(invalid="ignore"):
+        steep = ~np.isfinite(z) | ~np.isfinite(slope) | (slope > max_slope_rad + _EPS)
+    ys, xs = np.ogrid[y0 - iy:y1 - iy, x0 - ix:x1 - ix]
+    disc = np.hypot(xs, ys) <= radius / grid.resolution + _EPS
+    return bool((steep & disc).any())
+
+
+def body_cost_factors(grid: GridMap, max_slope_rad: float, radius: float,
+                      robot_cell: tuple[int, int]) -> np.ndarray:
+    """:func:`cell_cost_factors` with the ``radius`` margin closed: ``inf`` on steep cells and on
+    cells within ``radius`` of one (centre to centre: a robot centred there would overlap it),
+    1 elsewhere; except in the disc of ``radius`` plus one cell around ``robot_cell``
+    (``(ix, iy)``), where margin cells keep :data:`MARGIN_COST_FACTOR` so that a robot that is
+    there (a pose off by a few centimetres, a wall drawn next to it) can leave.
+
+    For a planner whose paths leave the cell centres (RRT*'s segments, its shortcuts): a margin
+    priced and not closed was crossed wherever that was the cheaper way, a corner cut through
+    for a shorter path (the campus's RRT* paths came within 0.01 m of a building, body to
+    wall)."""
+    factors = cell_cost_factors(grid, max_slope_rad, radius)
+    margin = factors == MARGIN_COST_FACTOR
+    h, w = factors.shape
+    ys, xs = np.ogrid[:h, :w]
+    reach = radius / grid.resolution + 1.0
+    near_robot = (xs - robot_cell[0]) ** 2 + (ys - robot_cell[1]) ** 2 <= reach * reach + _EPS
+    factors[margin & ~near_robot] = np.inf
+    return factors
+
+
 def terrain_regions(grid: GridMap, max_slope_rad: float) -> np.ndarray:
     """``[iy, ix]`` int32 labels: 0 on steep cells, else the region of the cell: the cells
     8-connected to it through cells that are not steep.
