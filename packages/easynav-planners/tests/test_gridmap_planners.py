@@ -444,7 +444,7 @@ def test_astar_margin_takes_the_radius_of_robot_geometry(caplog):
 
 def _margin_cells_crossed(grid, path, radius, robot):
     """The cells within ``radius`` of steep terrain (centre to centre) a path crosses (sampled
-    every 1/8 cell), leaving out those within ``radius`` plus a cell of ``robot``."""
+    every 1/8 cell), leaving out those the planner opens around ``robot``."""
     margin = cell_cost_factors(grid, math.radians(LIMIT_DEG), radius) == MARGIN_COST_FACTOR
     points = np.array([(p.x, p.y) for p in path.poses])
     crossed = set()
@@ -453,7 +453,8 @@ def _margin_cells_crossed(grid, path, radius, robot):
         t = np.linspace(0, 1, n + 1)[:, None]
         for x, y in a + t * (b - a):
             ix, iy = (int(v) for v in grid.world_to_cell(x, y))
-            if margin[iy, ix] and math.hypot(x - robot[0], y - robot[1]) > radius + grid.resolution:
+            reopened = math.sqrt(2) * (radius + grid.resolution) + grid.resolution
+            if margin[iy, ix] and math.hypot(x - robot[0], y - robot[1]) > reopened:
                 crossed.add((ix, iy))
     return crossed
 
@@ -488,7 +489,7 @@ def test_rrtstar_leaves_the_margin_it_starts_in_and_refuses_a_goal_inside_it():
     nav_state = state_with(grid, (1.0, 5.5), (3.6, 1.0, 0.0))
     planner.update(nav_state)
     reason = ("goal (3.60, 1.00) is within the robot's radius (0.30 m) of terrain steeper than "
-              "30 deg")
+              "30 deg or unknown")
     assert nav_state.get("diagnostics.path", DiagnosticStatus).message == reason
     assert planner.take_goal_rejection() == reason
 
@@ -504,7 +505,8 @@ def test_body_cost_factors_close_the_margin_except_around_the_robot():
     assert (factors[priced == 1.0] == 1.0).all()
     margin = priced == MARGIN_COST_FACTOR
     iy, ix = np.nonzero(margin)
-    near = np.hypot(ix - robot[0], iy - robot[1]) <= 0.3 / grid.resolution + 1.0 + 1e-9
+    near = np.hypot(ix - robot[0], iy - robot[1]) <= math.sqrt(2) * (0.3 / grid.resolution + 1) + 1
+
     assert near.any() and (~near).any()
     assert (factors[iy[near], ix[near]] == MARGIN_COST_FACTOR).all()
     assert np.isinf(factors[iy[~near], ix[~near]]).all()
@@ -519,3 +521,18 @@ def test_steep_within_is_the_margin_rule_for_one_cell():
         within = np.array([[steep_within(grid, ix, iy, radius, limit) for ix in range(w)]
                            for iy in range(h)])
         assert (within == (factors > 1.0)).all(), radius
+
+
+@pytest.mark.parametrize("offset", [-0.03, 0.0, 0.03, 0.05, 0.08])
+def test_rrtstar_leaves_an_inside_corner_it_starts_in(offset):
+    # From a corner, the nearest cell out of the margin is on the diagonal: a disc of the
+    # margin's width around the robot left it shut in ("unreachable").
+    resolution = 0.05
+    xs = (np.arange(160) + 0.5) * resolution
+    x, y = np.meshgrid(xs, xs)
+    grid = GridMap.from_elevation(np.where((x < 1.0) | (y < 1.0), 2.0, 0.0), resolution)
+    start = (1.05 + offset, 1.05 + offset)
+    nav_state = state_with(grid, start, (6.0, 6.0, 0.0))
+    make_planner(GridMapRRTStarPlanner, {"max_iters": 1500}).update(nav_state)
+    assert len(nav_state.get("path", Path)) > 1, (
+        nav_state.get("diagnostics.path", DiagnosticStatus).message)

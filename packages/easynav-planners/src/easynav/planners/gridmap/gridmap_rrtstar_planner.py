@@ -161,7 +161,7 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
         ix, iy = (int(v) for v in grid.world_to_cell(gx, gy))
         if steep_within(grid, ix, iy, radius, math.radians(limit_deg)):
             return (f"{goal_text} is within the robot's radius ({radius:.2f} m) of terrain "
-                    f"steeper than {limit_deg:g} deg")
+                    f"steeper than {limit_deg:g} deg or unknown")
         return None
 
     def plan(self, grid: GridMap, start: tuple[float, float],
@@ -177,8 +177,9 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
             if cell_is_steep(grid, gx, gy, max_slope):
                 return PlanResult(reason=f"the goal is on terrain steeper than "
                                          f"{p.max_allowed_slope_deg:g} deg or unknown")
-            return PlanResult(reason=f"the robot's circle there ({radius:.2f} m) overlaps "
-                                     f"terrain steeper than {p.max_allowed_slope_deg:g} deg")
+            return PlanResult(reason=f"the goal is within the robot's radius ({radius:.2f} m) "
+                                     f"of terrain steeper than {p.max_allowed_slope_deg:g} deg "
+                                     f"or unknown")
         # Reachable at all? The regions answer "no" for a goal walled off (inside a building:
         # 5 s of A* over every cell the robot reaches on the campus, 2 ms here); A* answers the
         # rest as a Dijkstra from the start would, exploring towards the goal only (the
@@ -197,8 +198,10 @@ class GridMapRRTStarPlanner(GridMapPlannerBase):
         segments = TerrainSegments(grid, factors, max_slope)
         found = rrt_star(segments, start, goal[:2], settings)
         if found is None:
-            return PlanResult(reason=f"RRT* found no path in {p.max_iters} iterations "
-                                     f"(the goal is reachable: raise max_iters)")
+            return PlanResult(reason=f"RRT* found no path in {p.max_iters} iterations (A* "
+                                     f"found one: raise max_iters; a passage barely wider than "
+                                     f"the robot and not along a grid axis or diagonal may be "
+                                     f"out of RRT*'s reach)")
         path = shortcut(segments, found[0], p.max_lateral_deviation)
         points = resample(path, p.spacing)
         poses = yaws_along(points, goal[2], p.final_poses_with_goal_orientation)

@@ -2,8 +2,9 @@
 
 A cell is *steep* when its terrain slope (the map's ``slope`` layer) exceeds the limit or its
 elevation is unknown: it is never entered. A cell within ``margin`` metres of a steep one is a
-*margin* cell: it may be entered at :data:`MARGIN_COST_FACTOR` times the cost (so paths keep
-their distance when they can, and a robot starting next to a slope can still leave). A move
+*margin* cell: A* may enter it at :data:`MARGIN_COST_FACTOR` times the cost (so paths keep
+their distance when they can, and a robot starting next to a slope can still leave); RRT* never
+crosses one within the robot's radius, except around the robot (:func:`body_cost_factors`). A move
 between two cells is allowed when the slope of the line joining their centres,
 ``atan(|dz| / horizontal distance)``, does not exceed the limit (the original's edge rule).
 All functions are pure (no state) and safe to call from any thread.
@@ -75,9 +76,10 @@ def body_cost_factors(grid: GridMap, max_slope_rad: float, radius: float,
                       robot_cell: tuple[int, int]) -> np.ndarray:
     """:func:`cell_cost_factors` with the ``radius`` margin closed: ``inf`` on steep cells and on
     cells within ``radius`` of one (centre to centre: a robot centred there would overlap it),
-    1 elsewhere; except in the disc of ``radius`` plus one cell around ``robot_cell``
-    (``(ix, iy)``), where margin cells keep :data:`MARGIN_COST_FACTOR` so that a robot that is
-    there (a pose off by a few centimetres, a wall drawn next to it) can leave.
+    1 elsewhere; except around ``robot_cell`` (``(ix, iy)``), where margin cells keep
+    :data:`MARGIN_COST_FACTOR` so that a robot that is there (a pose off by a few centimetres,
+    a wall drawn next to it) can leave. That disc is sqrt(2) times the margin's width plus a
+    cell: from an inside corner, the nearest cell out of the margin is on the diagonal.
 
     For a planner whose paths leave the cell centres (RRT*'s segments, its shortcuts): a margin
     priced and not closed was crossed wherever that was the cheaper way, a corner cut through
@@ -87,7 +89,7 @@ def body_cost_factors(grid: GridMap, max_slope_rad: float, radius: float,
     margin = factors == MARGIN_COST_FACTOR
     h, w = factors.shape
     ys, xs = np.ogrid[:h, :w]
-    reach = radius / grid.resolution + 1.0
+    reach = math.sqrt(2.0) * (radius / grid.resolution + 1.0) + 1.0
     near_robot = (xs - robot_cell[0]) ** 2 + (ys - robot_cell[1]) ** 2 <= reach * reach + _EPS
     factors[margin & ~near_robot] = np.inf
     return factors
