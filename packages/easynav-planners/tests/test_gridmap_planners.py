@@ -447,13 +447,13 @@ def _margin_cells_crossed(grid, path, radius, robot):
     every 1/8 cell), leaving out those the planner opens around ``robot``."""
     margin = cell_cost_factors(grid, math.radians(LIMIT_DEG), radius) == MARGIN_COST_FACTOR
     points = np.array([(p.x, p.y) for p in path.poses])
+    reopened = math.sqrt(2) * (radius + grid.resolution) + grid.resolution
     crossed = set()
     for a, b in itertools.pairwise(points):
         n = max(1, math.ceil(math.hypot(*(b - a)) / (grid.resolution / 8)))
         t = np.linspace(0, 1, n + 1)[:, None]
         for x, y in a + t * (b - a):
             ix, iy = (int(v) for v in grid.world_to_cell(x, y))
-            reopened = math.sqrt(2) * (radius + grid.resolution) + grid.resolution
             if margin[iy, ix] and math.hypot(x - robot[0], y - robot[1]) > reopened:
                 crossed.add((ix, iy))
     return crossed
@@ -506,7 +506,6 @@ def test_body_cost_factors_close_the_margin_except_around_the_robot():
     margin = priced == MARGIN_COST_FACTOR
     iy, ix = np.nonzero(margin)
     near = np.hypot(ix - robot[0], iy - robot[1]) <= math.sqrt(2) * (0.3 / grid.resolution + 1) + 1
-
     assert near.any() and (~near).any()
     assert (factors[iy[near], ix[near]] == MARGIN_COST_FACTOR).all()
     assert np.isinf(factors[iy[~near], ix[~near]]).all()

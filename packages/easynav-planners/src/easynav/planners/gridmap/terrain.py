@@ -26,12 +26,15 @@ NEIGHBOURS_8 = ((-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1
 _EPS = 1e-9
 
 
-def steep_cells(grid: GridMap, max_slope_rad: float) -> np.ndarray:
-    """``[iy, ix]`` bool: slope above the limit, or unknown elevation or slope."""
-    slope = grid.layer("slope")
-    elevation = grid.elevation
+def _steep(elevation: np.ndarray, slope: np.ndarray, max_slope_rad: float) -> np.ndarray:
+    """The steep rule on matching arrays of elevation and slope."""
     with np.errstate(invalid="ignore"):
         return ~np.isfinite(elevation) | ~np.isfinite(slope) | (slope > max_slope_rad + _EPS)
+
+
+def steep_cells(grid: GridMap, max_slope_rad: float) -> np.ndarray:
+    """``[iy, ix]`` bool: slope above the limit, or unknown elevation or slope."""
+    return _steep(grid.elevation, grid.layer("slope"), max_slope_rad)
 
 
 def cell_is_steep(grid: GridMap, ix: int, iy: int, max_slope_rad: float) -> bool:
@@ -63,10 +66,8 @@ def steep_within(grid: GridMap, ix: int, iy: int, radius: float, max_slope_rad: 
     r = int(math.floor(radius / grid.resolution + _EPS))
     h, w = grid.shape
     y0, y1, x0, x1 = max(iy - r, 0), min(iy + r + 1, h), max(ix - r, 0), min(ix + r + 1, w)
-    z = grid.elevation[y0:y1, x0:x1]
-    slope = grid.layer("slope")[y0:y1, x0:x1]
-    with np.errstate(invalid="ignore"):
-        steep = ~np.isfinite(z) | ~np.isfinite(slope) | (slope > max_slope_rad + _EPS)
+    steep = _steep(grid.elevation[y0:y1, x0:x1], grid.layer("slope")[y0:y1, x0:x1],
+                   max_slope_rad)
     ys, xs = np.ogrid[y0 - iy:y1 - iy, x0 - ix:x1 - ix]
     disc = np.hypot(xs, ys) <= radius / grid.resolution + _EPS
     return bool((steep & disc).any())
