@@ -37,7 +37,6 @@ from easynav.core.plugins.compatibility import (
 from easynav.core.plugins.discovery import list_plugins, load_plugin_class
 from easynav.core.plugins.plugin_kinds import ALL_KINDS
 from easynav.system.cli.params_file import load_ros_yaml
-from easynav.system.node_declarations import SYSTEM_PARAMETERS
 
 ROOT = Path(__file__).resolve().parents[2]
 PARAMS_DIR = ROOT / "params"
@@ -588,33 +587,6 @@ def run_combination(
     return Outcome(combo, code, summary, error)
 
 
-@functools.cache
-def system_rt_freq() -> float:
-    """The RT cycle's frequency of every row: system_node's ``rt_freq`` in the playground's
-    file, which the rows keep, else its default."""
-    system = load_ros_yaml(BASE_PARAMS.read_text()).get("system_node") or {}
-    value = (system.get("ros__parameters") or {}).get("rt_freq")
-    if value is None:
-        value = next(p.default for p in SYSTEM_PARAMETERS if p.name == "rt_freq")
-    return float(value)
-
-
-def late_cycles_text(summary: dict) -> str:
-    """The late RT cycles of a run and their share of the RT cycles in the mission's wall-clock
-    time (``rt_freq`` times the simulated navigation time over the real-time factor). A count
-    alone says little: 2000 is one cycle in 20 of a 200 s campus tour at 200 Hz and one in 6
-    of a 60 s tour of home. The count runs from EasyNav's activation, so the cycles late
-    before the first goal (a few at start-up) count in the share too."""
-    late = summary.get("late_rt_cycles")
-    if late is None:
-        return "—"
-    simulated, factor = summary.get("navigation_time"), summary.get("real_time_factor")
-    if not simulated or not factor:
-        return str(late)
-    share = 100.0 * late / (simulated / factor * system_rt_freq())
-    return f"{late} ({share:.1f} %)" if share < 10.0 else f"{late} ({share:.0f} %)"
-
-
 def _num(value, fmt: str) -> str:
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "—"
@@ -654,8 +626,7 @@ def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | N
         header,
         "",
         "| maps manager | localizer | planner | controller | world | reached | time (s) | "
-        "distance (m) | min clearance (m) | loc. error mean / max (m) | late RT cycles (share) | "
-        "verdict |",
+        "distance (m) | min clearance (m) | loc. error mean / max (m) | late RT cycles | verdict |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for o in outcomes:
@@ -666,7 +637,7 @@ def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | N
             f"{_num(s.get('navigation_time'), '.1f')} | {_num(s.get('distance_driven'), '.1f')} | "
             f"{_num(s.get('min_clearance'), '.2f')} | "
             f"{_num(s.get('localisation_mean'), '.3f')} / {_num(s.get('localisation_max'), '.3f')}"
-            f" | {late_cycles_text(s)} | {verdict(o, findings).replace('|', '/')} |"
+            f" | {_num(s.get('late_rt_cycles'), 'd')} | {verdict(o, findings).replace('|', '/')} |"
         )
     green = sum(o.green for o in outcomes)
     explained = sum(not o.green and any(f.explains(o.combination) for f in findings)

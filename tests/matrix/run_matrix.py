@@ -301,12 +301,7 @@ def main(argv: list[str]) -> int:
         "time, but EasyNav's loops keep their wall-clock rates: its RT cycles per simulated "
         "second are halved (a controller or smoother set faster than that runs slower), and "
         "every computation takes twice as long in simulated time. A row that fails so is run "
-        "again at x1 before it is looked into. Late RT cycles (EasyNav's heartbeat) started more "
-        "than `safety.rt_monitor.max_period_factor` periods after the previous one (2, 10 ms at "
-        "200 Hz), counted from EasyNav's activation; their share is of the cycles in the "
-        "mission's wall-clock time. A controller whose update takes longer than that makes "
-        "each RT cycle that runs it late, and often the next (MPPI's 12 to 20 ms medians here, at "
-        "its 20 Hz: 9 to 17 %).",
+        "again at x1 before it is looked into.",
         "",
         (f"- date: {started:%Y-%m-%d %H:%M} UTC, written from {results_path.name} (nothing run)"
          if args.report else

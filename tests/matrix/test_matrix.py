@@ -19,7 +19,6 @@ from matrix import (
     combinations,
     compose_params,
     covering_slice,
-    late_cycles_text,
     load_findings,
     markdown,
     mission_timeout,
@@ -28,7 +27,6 @@ from matrix import (
     plugin_sections,
     representative_sections,
     run_combination,
-    system_rt_freq,
     unmatched_plugins,
     verdict,
 )
@@ -266,23 +264,6 @@ def test_a_failed_row_says_why_when_a_finding_explains_it():
     text = markdown([failed, green], "# header", findings=[found])
     assert "Why: the localizer drifts." in text
     assert "1 of 2 runs green; of the 1 failed, 1 explained" in text
-
-
-def test_late_rt_cycles_are_shown_with_their_share_of_the_missions_cycles():
-    # The rows keep the playground's RT cycle (200 Hz): a 200 s mission at real time is 40 000
-    # cycles, at x2 (a real-time factor of 2) 20 000.
-    assert system_rt_freq() == 200.0
-    assert late_cycles_text({"late_rt_cycles": 2000, "navigation_time": 200.0,
-                             "real_time_factor": 1.0}) == "2000 (5.0 %)"
-    assert late_cycles_text({"late_rt_cycles": 2000, "navigation_time": 200.0,
-                             "real_time_factor": 2.0}) == "2000 (10 %)"
-    # A run that stopped before its summary had a time: the count alone, or nothing.
-    assert late_cycles_text({"late_rt_cycles": 12, "navigation_time": 0.0}) == "12"
-    assert late_cycles_text({}) == "—"
-    combo = Combination("m/M", "l/L", "p/P", "c/C", "home")
-    row = Outcome(combo, 0, {"success": True, "waypoints": 4, "reached": 4, "late_rt_cycles": 6,
-                             "navigation_time": 60.0, "real_time_factor": 1.0})
-    assert "| 6 (0.1 %) | green |" in markdown([row], "# header")
 
 
 def test_the_shipped_findings_name_installed_plugins_and_matrix_worlds():
