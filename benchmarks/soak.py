@@ -38,6 +38,7 @@ import math
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -458,7 +459,8 @@ def main() -> int:
         "minutes have passed, then finishes the goal it is driving to; faster than real time. "
         "The `easynav run` process is sampled from /proc every second.",
         "",
-        f"- date: {date}; machine: {platform.machine()}, {_cores()} cores, Python "
+        f"- date: {date}; commit {_commit()}; machine: {platform.machine()}, {_cores()} "
+        f"cores, Python "
         f"{platform.python_version()}; load average at the end {_load()}",
         f"- simulated patrol: {patrol_min:.1f} min ({args.minutes:g} requested), {run.laps} "
         f"lap(s) begun; result {run.final_state}"
@@ -495,6 +497,17 @@ def main() -> int:
 
 def _yes(flag: bool) -> str:
     return "yes" if flag else "**no**"
+
+
+def _commit() -> str:
+    """The commit the soak ran (short hash, ``+changes`` when the tree differs): its figures
+    describe that code."""
+    def git(*args: str) -> str:
+        done = subprocess.run(["git", *args], cwd=REPO, capture_output=True, text=True)
+        return done.stdout.strip() if done.returncode == 0 else ""
+
+    commit = git("rev-parse", "--short", "HEAD") or "unknown"
+    return commit + ("+changes" if git("status", "--porcelain", "--untracked-files=no") else "")
 
 
 def _cores() -> int:
