@@ -184,6 +184,7 @@ class SimplePathFollower:
         self._w = 0.0
         self._goal: tuple[float, float, float] | None = None
         self._final_rotation = False
+        self._reapproach = False  # turned at the goal but beyond the stop distance: go nearer
         self._state = NO_PATH
         # The path being followed (its identity), its pieces between cusps, the current one.
         self._segments_of: np.ndarray | None = None
@@ -198,7 +199,7 @@ class SimplePathFollower:
         self.angular_pid.reset()
         self._v = self._w = 0.0
         self._goal = None
-        self._final_rotation = False
+        self._final_rotation = self._reapproach = False
         self._state = NO_PATH
 
     def _forget_path(self) -> None:
@@ -273,7 +274,7 @@ class SimplePathFollower:
             or max(abs(a - b) for a, b in zip(goal, self._goal, strict=True)) > 1e-6
         ):
             self._goal = goal  # a new goal: decide the final approach afresh
-            self._final_rotation = False
+            self._final_rotation = self._reapproach = False
         # Anti-windup: the integral terms may never ask for more than the robot can do (the
         # PIDs' outputs are saturated below, by these same limits).
         self.linear_pid.integral_limit = max(limits.max_linear_vel, 0.0)
@@ -289,9 +290,18 @@ class SimplePathFollower:
         if not self.allow_reversing or limits.min_linear_vel >= 0.0:
             direction = 1  # this robot does not reverse: drive the segment forward
 
+        # The final rotation goes on up to twice the stop distance away (the estimate moves as
+        # the robot turns), but the robot is arrived only within it, at most the goal manager's
+        # tolerance: stopped beyond, the goal manager would wait for a goal it never sees
+        # reached. Turned but beyond it, the approach starts again, to half the stop distance.
+        if (self._final_rotation and dist_goal > stop_dist
+                and abs(yaw_error) <= stop_yaw):
+            self._final_rotation, self._reapproach = False, True
+        arrive = 0.5 * stop_dist if self._reapproach else stop_dist
         if on_last and (
-            dist_goal <= stop_dist or (self._final_rotation and dist_goal <= 2.0 * stop_dist)
+            dist_goal <= arrive or (self._final_rotation and dist_goal <= 2.0 * stop_dist)
         ):
+            self._reapproach = False
             if not self._final_rotation:
                 # A new objective (the goal's yaw, not the carrot's bearing): the heading
                 # integral of the approach must not push the final turn.

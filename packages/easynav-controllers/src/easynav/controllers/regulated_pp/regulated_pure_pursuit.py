@@ -160,6 +160,7 @@ class RegulatedPurePursuit:
         self._rotating = False
         self._rotation_sign = 0.0
         self._at_goal_xy = False
+        self._reapproach = False  # turned at the goal but beyond its tolerance: go nearer
 
     @property
     def last_command(self) -> tuple[float, float]:
@@ -173,7 +174,7 @@ class RegulatedPurePursuit:
         self._s = np.concatenate(([0.0], np.cumsum(lengths)))
         self._cusps = cusp_indices(self._path_xy)
         self._segment = -1
-        self._at_goal_xy = False
+        self._at_goal_xy = self._reapproach = False
 
     def _active_end(self, allow_reversing: bool) -> int:
         """The last vertex of the part being followed: the next cusp, else the goal."""
@@ -251,16 +252,24 @@ class RegulatedPurePursuit:
         seg, t, projection, end = self._track(position, lookahead, allow_reversing)
         final_part = end == len(self._path_xy) - 1
         goal_dist = math.hypot(goal[0] - x, goal[1] - y)
-        if final_part and (goal_dist <= xy_tolerance or
+        # The turn to the goal's yaw goes on up to twice the position tolerance away (the
+        # estimate moves as the robot turns), but the robot is arrived only within it, the goal
+        # manager's tolerance: stopped beyond it, the goal manager would wait for ever. Turned
+        # but beyond it, the robot approaches again, to half the tolerance.
+        arrive = 0.5 * xy_tolerance if self._reapproach else xy_tolerance
+        if final_part and (goal_dist <= arrive or
                            (self._at_goal_xy and goal_dist <= 2.0 * xy_tolerance)):
-            self._at_goal_xy = True
             error = self._latch(normalize_angle(float(goal[2]) - yaw))
-            if abs(error) <= yaw_tolerance:
-                self._rotation_sign = 0.0
-                return self._out(0.0, 0.0, ARRIVED)
-            w = rotation_speed(error, self._last[1], dt, p["rotate_to_heading_angular_vel"],
-                               limits.max_angular_acc, limits.max_angular_decel, max_w)
-            return self._out(0.0, w, ROTATING_TO_GOAL)
+            if abs(error) > yaw_tolerance or goal_dist <= xy_tolerance:
+                self._at_goal_xy, self._reapproach = True, False
+                if abs(error) <= yaw_tolerance:
+                    self._rotation_sign = 0.0
+                    return self._out(0.0, 0.0, ARRIVED)
+                w = rotation_speed(error, self._last[1], dt, p["rotate_to_heading_angular_vel"],
+                                   limits.max_angular_acc, limits.max_angular_decel, max_w)
+                return self._out(0.0, w, ROTATING_TO_GOAL)
+            self._rotation_sign = 0.0
+            self._reapproach = True
         self._at_goal_xy = False
 
         carrot = carrot_point(self._path_xy, position, seg + 1, end, lookahead,
