@@ -7,15 +7,21 @@ are not navigation plugins), kept when each plugin's needed map representation
 (``NEEDS_MAPS``) is one the maps manager provides (``PROVIDES_MAPS``). A new plugin joins the
 matrix by being installed.
 
-Each plugin runs with its representative configuration: its section in the first params file
-under ``params/`` that uses it (every plugin ships one), or its declared defaults. The rest of
-the configuration (sensors, robot limits and geometry, recovery) is the playground's own params
-file. A run is one waypoint mission of the playground demo (``run_demo``); its figures come from
-the demo's ``summary.json``.
+Each plugin runs with its representative configuration (:func:`representative_sections`): its
+section in a params file under ``params/`` written for the row's world (its ``# Run: ...
+--world NAME`` line), else in the playground's file, else in the first file that uses it (every
+plugin ships one); a maps stack of two managers takes both sections from a file that stacks
+them. The rest (robot limits and geometry, recovery) is the playground's own params file, with
+the sensors the chosen plugins read added from their files. A run is one waypoint mission of
+the playground demo (``run_demo``); its figures come from the demo's ``summary.json``.
+
+CI runs :func:`ci_slice`: the combinations that together use every plugin, each in the first
+world that suits it, on the first :data:`SLICE_TOUR_METRES` of that world's tour.
 """
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import functools
 import io
@@ -23,6 +29,7 @@ import itertools
 import json
 import math
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -87,12 +94,16 @@ class Combination:
 
 @dataclass
 class Outcome:
-    """What one run of a combination gave (from the demo's summary.json)."""
+    """What one run of a combination gave (from the demo's summary.json). ``ran``: the code and
+    speed it ran with (``11a8747 x2``; the report's "run" column). ``stale``: it ran with params
+    other than the combination composes to now (a params file retuned since): to run again."""
 
     combination: Combination
     exit_code: int
     summary: dict = field(default_factory=dict)
     error: str = ""
+    ran: str = ""
+    stale: bool = False
 
     @property
     def green(self) -> bool:
@@ -333,6 +344,14 @@ def covering_slice(combos: list[Combination]) -> list[Combination]:
     return chosen
 
 
+def ci_slice() -> list[Combination]:
+    """The combinations CI runs: the covering slice over every world, so each combination
+    drives in the first world that suits it (home, unless it reads a sensor only the campus
+    has: the GNSS localizers, the GridMap stack's elevation). CI drives each on
+    :func:`slice_waypoints` of its world's tour."""
+    return covering_slice(combinations())
+
+
 #: The world a params file was written for: its "# Run: easynav demo --world NAME" line.
 _RUN_WORLD = re.compile(r"^#.*?\bRun:.*?--world\s+(\w+)", re.MULTILINE)
 
@@ -543,41 +562,93 @@ TIMEOUT_PER_METRE = 6.0
 MIN_TIMEOUT = 600.0
 
 
+#: CI's slice drives each world's tour this far at most (the start, then each waypoint, in
+#: straight lines; the first waypoint at least): home's whole tour (17 m) and the campus's first
+#: leg (30 m), where the whole campus tour (190 m) would take 4 to 8 minutes a row.
+SLICE_TOUR_METRES = 40.0
+
+
 @functools.cache
-def mission_timeout(world: str) -> float:
-    """Wall seconds before a mission in ``world`` is cancelled (see TIMEOUT_PER_METRE)."""
+def tour_legs(world: str) -> tuple[float, ...]:
+    """The lengths of the legs of ``world``'s tour: the start to its first waypoint, then each
+    waypoint to the next, in straight lines (m)."""
     from easynav.playground.world_description import WorldDescription, load_waypoints
 
     description = WorldDescription.resolve(world)
     waypoints = load_waypoints(description.waypoints_path)
     points = [description.start_pose[:2]] + [w[:2] for w in waypoints]
-    tour = sum(math.dist(a, b) for a, b in zip(points, points[1:], strict=False))
+    return tuple(math.dist(a, b) for a, b in zip(points, points[1:], strict=False))
+
+
+def slice_waypoints(world: str, metres: float = SLICE_TOUR_METRES) -> int | None:
+    """How many of ``world``'s waypoints CI's slice drives to: as many as fit in ``metres`` of
+    tour, one at least; None when the whole tour fits."""
+    legs = tour_legs(world)
+    count = max(1, sum(1 for total in itertools.accumulate(legs) if total <= metres))
+    return None if count >= len(legs) else count
+
+
+def mission_timeout(world: str, waypoints: int | None = None) -> float:
+    """Wall seconds before a mission in ``world`` (its first ``waypoints``, None: all) is
+    cancelled (see TIMEOUT_PER_METRE)."""
+    tour = sum(tour_legs(world)[:waypoints])
     return max(MIN_TIMEOUT, TIMEOUT_PER_METRE * tour)
 
 
+class _Tee(io.TextIOBase):
+    """``sys.stderr`` that also copies what Python code writes to ``copy``. Code that needs a
+    file descriptor (a StringIO has none: the demo failed with "fileno") gets the real one."""
+
+    def __init__(self, stream, copy: io.StringIO) -> None:
+        self._stream, self._copy = stream, copy
+
+    def write(self, text: str) -> int:
+        self._copy.write(text)
+        return self._stream.write(text)
+
+    def flush(self) -> None:
+        self._stream.flush()
+
+    def fileno(self) -> int:
+        return self._stream.fileno()
+
+
 def run_combination(
-    combo: Combination, run_dir: Path, speed_up: float = 1.0, timeout: float | None = None
+    combo: Combination, run_dir: Path, speed_up: float = 1.0, timeout: float | None = None,
+    waypoints: int | None = None,
 ) -> Outcome:
     """Run one combination's waypoint mission in the playground (``timeout``: wall seconds,
-    by default :func:`mission_timeout` of its world)."""
+    by default :func:`mission_timeout` of its world; ``waypoints``: only the first ones of the
+    world's tour, None: all)."""
     from easynav.playground.demo import run_demo
+    from easynav.playground.world_description import WorldDescription, load_waypoints
 
     run_dir.mkdir(parents=True, exist_ok=True)
     params = run_dir / "matrix.params.yaml"
     params.write_text(yaml.safe_dump(compose_params(combo), sort_keys=False))
     out = io.StringIO()
     try:
-        code = run_demo(
-            world=combo.world,
-            params_file=params,
-            speed_up=speed_up,
-            output_png=run_dir / "run.png",
-            timeout=mission_timeout(combo.world) if timeout is None else timeout,
-            run_dir=run_dir / "run",
-            stream=out,
-        )
+        tour = None
+        if waypoints is not None:
+            path = WorldDescription.resolve(combo.world).waypoints_path
+            tour = load_waypoints(path)[:waypoints]
+        # run_demo prints a usage error (a bad world, a params file it cannot read) to stderr:
+        # a copy goes to ``out``, so that the row says it instead of "exit 2".
+        with contextlib.redirect_stderr(_Tee(sys.stderr, out)):
+            code = run_demo(
+                world=combo.world,
+                params_file=params,
+                waypoints=tour,
+                speed_up=speed_up,
+                output_png=run_dir / "run.png",
+                timeout=mission_timeout(combo.world, waypoints) if timeout is None else timeout,
+                run_dir=run_dir / "run",
+                stream=out,
+            )
     except Exception as exc:  # a crash of the harness is a row, not the end of the matrix
         return Outcome(combo, 1, error=f"{type(exc).__name__}: {exc}")
+    finally:  # the demo's progress lines and summary, to look into a run afterwards
+        (run_dir / "demo.log").write_text(out.getvalue())
     summary_path = run_dir / "run" / "summary.json"
     summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
     error = ""
@@ -585,6 +656,11 @@ def run_combination(
         lines = [line for line in out.getvalue().splitlines() if line.strip()]
         error = summary.get("status_message") or (lines[-1] if lines else f"exit {code}")
     return Outcome(combo, code, summary, error)
+
+
+def _first_line(text: str) -> str:
+    """The first non-blank line of ``text`` (a multi-line error in one table cell)."""
+    return next((line.strip() for line in str(text).splitlines() if line.strip()), "")
 
 
 def _num(value, fmt: str) -> str:
@@ -604,19 +680,20 @@ def _failure(outcome: Outcome) -> str:
     if s.get("waypoints") and s.get("reached", 0) < s["waypoints"]:
         found.append(f"{s.get('reached', 0)} of {s['waypoints']} waypoints reached")
     if outcome.error:
-        found.append(outcome.error)
+        found.append(_first_line(outcome.error))
     return "; ".join(found) or "see the run"
 
 
 def verdict(outcome: Outcome, findings: list[Finding] = ()) -> str:
     """A row's verdict: green, or what failed and why (the findings that explain it), or that
-    nobody has looked into it yet."""
+    nobody has looked into it yet; a stale row (run with params since changed) says so."""
+    stale = " (**stale**: run with params changed since; to run again)" if outcome.stale else ""
     if outcome.green:
-        return "green"
+        return "green" + stale
     causes = [f.cause for f in findings if f.explains(outcome.combination)]
     if causes:
-        return f"**FAILED**: {_failure(outcome)}. Why: {' '.join(causes)}"
-    return f"**FAILED** (not looked into yet): {_failure(outcome)}"
+        return f"**FAILED**{stale}: {_failure(outcome)}. Why: {' '.join(causes)}"
+    return f"**FAILED** (not looked into yet){stale}: {_failure(outcome)}"
 
 
 def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | None = None,
@@ -625,9 +702,10 @@ def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | N
     lines = [
         header,
         "",
-        "| maps manager | localizer | planner | controller | world | reached | time (s) | "
-        "distance (m) | min clearance (m) | loc. error mean / max (m) | late RT cycles | verdict |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| maps manager | localizer | planner | controller | world | reached | "
+        "time (s, simulated) | distance (m) | min clearance (m) | loc. error mean / max (m) | "
+        "late RT cycles | run | verdict |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for o in outcomes:
         s, c = o.summary, o.combination
@@ -637,13 +715,17 @@ def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | N
             f"{_num(s.get('navigation_time'), '.1f')} | {_num(s.get('distance_driven'), '.1f')} | "
             f"{_num(s.get('min_clearance'), '.2f')} | "
             f"{_num(s.get('localisation_mean'), '.3f')} / {_num(s.get('localisation_max'), '.3f')}"
-            f" | {_num(s.get('late_rt_cycles'), 'd')} | {verdict(o, findings).replace('|', '/')} |"
+            f" | {_num(s.get('late_rt_cycles'), 'd')} | {o.ran or '—'} | "
+            f"{verdict(o, findings).replace('|', '/')} |"
         )
     green = sum(o.green for o in outcomes)
     explained = sum(not o.green and any(f.explains(o.combination) for f in findings)
                     for o in outcomes)
+    stale = sum(o.stale for o in outcomes)
     lines += ["", f"{green} of {len(outcomes)} runs green; of the {len(outcomes) - green} "
-              f"failed, {explained} explained (tests/matrix/findings.yaml).", ""]
+              f"failed, {explained} explained (tests/matrix/findings.yaml)"
+              + (f"; {stale} stale (run with params changed since: to run again)" if stale
+                 else "") + ".", ""]
     if unmatched:
         lines += ["Installed navigation plugins in no combination (nothing to run them with):", ""]
         lines += [f"- `{name}`: {reason}" for name, reason in sorted(unmatched.items())]

@@ -3,7 +3,8 @@
 Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depot]
        [--speed-up 1.0] [--jobs 1] [--results FILE] [--output docs/matrix.md] [--list] [--report]
 
-  --slice    only the combinations that together use every plugin once (what CI runs)
+  --slice    only the combinations that together use every plugin once (CI runs them on the
+             first 40 m of their world's tour; --slice drives the whole tour, as every row)
   --speed-up the simulation's speed (x real time; EasyNav's loops keep their wall-clock rates,
              so its RT cycles per simulated second drop by as much). On a 2-core machine one
              mission at x2 ran at x1.9-2.0 with the same verdict and figures as at x1 (the
@@ -19,6 +20,8 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
              docs/matrix.md is written from the file; each row names the commit it ran.
   --fresh    forget the results file first
   --only S   only the combinations whose name contains one of the comma-separated S
+  --again S  run again the kept runs whose name contains one of the comma-separated S (a row
+             that failed at x2, run again at x1: --again NAME --speed-up 1); the new run wins
   --list     print the combinations and exit
   --report   write docs/matrix.md from the results file without running anything
   --merge F  append to the results file the runs that results files F... (copies of it that
@@ -177,6 +180,11 @@ def _run_in_process(name: str, run_dir: Path, args: argparse.Namespace) -> dict:
             "error": f"the harness failed: {tail[0]}", "run_dir": str(run_dir)}
 
 
+def _ran(row: dict) -> str:
+    """The report's "run" cell of a kept row: its commit and speed-up (``11a8747 x2``)."""
+    return f"{row.get('commit', '?')} x{float(row.get('speed_up', 1.0)):g}"
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--slice", action="store_true")
@@ -188,6 +196,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--results", default=str(DEFAULT_RESULTS))
     parser.add_argument("--fresh", action="store_true")
     parser.add_argument("--only", default="")
+    parser.add_argument("--again", default="")
     parser.add_argument("--output", default=str(ROOT / "docs" / "matrix.md"))
     parser.add_argument("--list", action="store_true")
     parser.add_argument("--merge", nargs="+", default=[], metavar="FILE")
@@ -224,9 +233,16 @@ def main(argv: list[str]) -> int:
         print(f"merged {appended} runs into {results_path}", flush=True)
         args.report = True
     kept = load_results(results_path)
-    fingerprints = {} if args.report else {c.name: params_fingerprint(c) for c in combos}
+    # The report needs the fingerprints of the kept rows only (a stale row says so); a run
+    # needs every combination's, to keep them in its rows.
+    fingerprints = {c.name: params_fingerprint(c) for c in combos
+                    if not args.report or c.name in kept}
     stale = stale_rows(combos, kept, fingerprints)
-    todo = [] if args.report else [c for c in combos if c.name not in kept or c.name in stale]
+    again = [part for part in args.again.split(",") if part]
+    todo = [] if args.report else [
+        c for c in combos
+        if c.name not in kept or c.name in stale or any(part in c.name for part in again)
+    ]
     done_before = sum(c.name in kept for c in combos) - len(stale)
     print(f"{len(combos)} combinations: {done_before} done in {results_path}, {len(stale)} "
           f"kept there with other params (run again), {len(todo)} to run, {args.jobs} at a time",
@@ -273,8 +289,10 @@ def main(argv: list[str]) -> int:
               "again to go on", flush=True)
     finally:
         pool.shutdown(wait=True, cancel_futures=True)  # queued runs never start
+    stale = stale_rows(combos, kept, fingerprints)  # the runs of this call are not
     outcomes = [
-        Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"])
+        Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"],
+                ran=_ran(kept[c.name]), stale=c.name in stale)
         for c in combos if c.name in kept
     ]
     commits: dict[str, int] = {}
@@ -291,7 +309,9 @@ def main(argv: list[str]) -> int:
         "Written by `make matrix` (tests/matrix/run_matrix.py): every compatible combination of "
         "the installed maps managers, localizers, planners and controllers (compatibility as the "
         "plugins declare it) in each world, each a waypoint mission of the playground. CI runs "
-        "the slice that uses every plugin at least once (`--slice`). Each plugin is configured "
+        "the combinations that together use every plugin at least once (`--slice`), each in "
+        "the first world that suits it (home, the campus for the plugins that need its "
+        "sensors), on the first 40 m of that world's tour. Each plugin is configured "
         "as in a params file written for the row's world where there is one (`# Run: ... "
         "--world NAME`: the tb3_sandbox's costmap files, the depot's costmap with its keepout "
         "and speed zones, the campus's files for the Simple* plugins), else as in the "
@@ -301,7 +321,14 @@ def main(argv: list[str]) -> int:
         "time, but EasyNav's loops keep their wall-clock rates: its RT cycles per simulated "
         "second are halved (a controller or smoother set faster than that runs slower), and "
         "every computation takes twice as long in simulated time. A row that fails so is run "
-        "again at x1 before it is looked into.",
+        "again at x1 before it is looked into. Columns: the time of the mission is simulated; "
+        "the minimum clearance is the robot's over the mission; the localisation error is "
+        "EasyNav's estimate against the truth over the whole run, from its first estimate; "
+        "late RT cycles (EasyNav's heartbeat) are those that started more than "
+        "`safety.rt_monitor.max_period_factor` (2) periods after the previous one, from "
+        "EasyNav's activation on; run: the commit and the speed-up the row ran with. A row "
+        "kept from a run whose params the combination no longer composes to (a params file "
+        "retuned since) is marked stale: it runs again with the next `make matrix`.",
         "",
         (f"- date: {started:%Y-%m-%d %H:%M} UTC, written from {results_path.name} (nothing run)"
          if args.report else
@@ -311,7 +338,8 @@ def main(argv: list[str]) -> int:
         "- this run: "
         + ("the covering slice only (`--slice`)" if args.slice else "every combination")
         + (f" whose name contains {args.only}" if args.only else "")
-        + f", worlds {args.worlds}: {len(outcomes)} of {len(combos)} runs done",
+        + f", worlds {args.worlds}: {len(outcomes) - len(stale)} of {len(combos)} runs done"
+        + (f" ({len(stale)} more kept stale: to run again)" if stale else ""),
         "- code of the rows: "
         + (", ".join(f"{key} ({n} rows)" for key, n in sorted(commits.items())) or "none yet"),
         "- speed-up of the rows: "

@@ -16,6 +16,7 @@ from matrix import (
     Combination,
     Finding,
     Outcome,
+    ci_slice,
     combinations,
     compose_params,
     covering_slice,
@@ -27,6 +28,7 @@ from matrix import (
     plugin_sections,
     representative_sections,
     run_combination,
+    slice_waypoints,
     unmatched_plugins,
     verdict,
 )
@@ -61,11 +63,25 @@ def test_no_combination_pairs_a_plugin_with_a_map_it_cannot_use():
             assert compatible(needed_maps(plugin_class(kind, name)), provides), combo
 
 
-def test_the_slice_covers_every_plugin():
+def test_cis_slice_covers_every_plugin_at_home_where_it_can():
     combos = combinations()
-    chosen = covering_slice(combos)
+    chosen = ci_slice()
+    assert chosen == covering_slice(combos)  # what `run_matrix.py --slice` runs
     assert {p for c in chosen for p in c.plugins} == {p for c in combos for p in c.plugins}
     assert len(chosen) <= sum(len(names) for names in navigation_plugins().values())
+    # Each in the first world that suits it: a combination that can run at home runs there.
+    at_home = {c.plugins for c in combinations(("home",))}
+    for combo in chosen:
+        assert (combo.world == "home") == (combo.plugins in at_home), combo.name
+
+
+def test_cis_slice_drives_the_first_40_m_of_a_long_tour():
+    # home's tour (17 m) whole; the campus's first leg (30 m) of its 190 m.
+    assert slice_waypoints("home") is None
+    assert slice_waypoints("campus") == 1
+    assert slice_waypoints("campus", metres=1.0) == 1  # the first waypoint at least
+    assert slice_waypoints("campus", metres=1000.0) is None
+    assert mission_timeout("campus", 1) == MIN_TIMEOUT < mission_timeout("campus")
 
 
 def test_composed_params_take_each_plugin_from_its_representative_file():
@@ -178,7 +194,27 @@ def test_a_row_kept_with_other_params_runs_again():
             home[1].name: {"params": "retuned"},
             home[2].name: {}}  # kept before rows had a fingerprint
     assert stale_rows(home, kept, prints) == {home[1].name, home[2].name}
-    assert stale_rows(home, kept, {}) == set()  # --report: nothing is run
+    assert stale_rows(home, kept, {}) == set()  # no fingerprints: nothing to compare
+
+
+def test_the_report_marks_a_stale_row_and_says_what_each_row_ran_with():
+    combo = Combination("m/M", "l/L", "p/P", "c/C", "home")
+    summary = {"success": True, "waypoints": 4, "reached": 4}
+    stale = Outcome(combo, 0, summary, ran="11a8747 x2", stale=True)
+    fresh = Outcome(combo, 0, summary, ran="3b39a3e x1")
+    assert verdict(stale) == "green (**stale**: run with params changed since; to run again)"
+    text = markdown([stale, fresh], "# header")
+    assert "| 11a8747 x2 | green (**stale**" in text and "| 3b39a3e x1 | green |" in text
+    assert "2 of 2 runs green; of the 0 failed, 0 explained (tests/matrix/findings.yaml); " \
+           "1 stale (run with params changed since: to run again)." in text
+
+
+def test_a_multi_line_error_keeps_its_first_line_in_the_table():
+    combo = Combination("m/M", "l/L", "p/P", "c/C", "home")
+    crashed = Outcome(combo, 1, {}, "RuntimeError: no map\nTraceback (most recent call last):")
+    assert verdict(crashed) == "**FAILED** (not looked into yet): RuntimeError: no map"
+    row = markdown([crashed], "# header").splitlines()[4]
+    assert row.endswith("| **FAILED** (not looked into yet): RuntimeError: no map |")
 
 
 def test_merging_a_clones_results_appends_its_newer_runs(tmp_path):
@@ -284,10 +320,10 @@ def test_a_malformed_finding_is_refused_naming_it(tmp_path):
     assert load_findings(tmp_path / "absent.yaml") == []
 
 
-# CI's slice drives in the home world (roomy: every stack's tuning fits it); the full matrix
-# (`make matrix`) adds the real maps and the campus, where the GNSS localizers join (their own
-# campus runs are in easynav-localizers' tests).
-SLICE = covering_slice(combinations(("home",)))
+# CI's slice: every plugin at least once, at home where the combination can run there (roomy:
+# every stack's tuning fits it), else on the campus's first leg; the full matrix
+# (`make matrix`) drives every combination's whole tour in every world that suits it.
+SLICE = ci_slice()
 
 
 @pytest.mark.slow
@@ -295,7 +331,8 @@ SLICE = covering_slice(combinations(("home",)))
 @pytest.mark.timeout(900)
 @pytest.mark.parametrize("combo", SLICE, ids=[c.name for c in SLICE])
 def test_slice_combination_completes_its_mission(combo: Combination, tmp_path):
-    outcome = run_combination(combo, tmp_path, timeout=600.0)
+    outcome = run_combination(combo, tmp_path, timeout=600.0,
+                              waypoints=slice_waypoints(combo.world))
     summary = outcome.summary
     assert outcome.green, f"{combo.name}: {outcome.error}\n{summary}"
     assert summary["collisions"] == 0 and summary["reached"] == summary["waypoints"]
