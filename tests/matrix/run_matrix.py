@@ -26,8 +26,9 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --report   write docs/matrix.md from the results file without running anything
   --merge F  append to the results file the runs that results files F... (copies of it that
              went on elsewhere: another clone, another machine) hold and it does not, then
-             write docs/matrix.md as --report does. Merge a clone's file before resetting
-             that clone, or its runs are lost
+             write docs/matrix.md as --report does (of two runs of a combination the one that
+             finished later counts). Merge a clone's file before resetting that clone, or its
+             runs are lost
 
 A failed row's verdict says what a user would notice first (collisions, waypoints missed, the
 run's message) and, when the failure was looked into, why: tests/matrix/findings.yaml lists the
@@ -73,24 +74,30 @@ DEFAULT_RESULTS = ROOT / "docs" / "matrix.results.jsonl"
 
 
 def load_results(path: Path) -> dict[str, dict]:
-    """The runs kept in ``path`` by combination name (the last line of a name wins); a line
-    cut short by a stopped run is skipped."""
+    """The runs kept in ``path`` by combination name: of two runs of a name, the one finished
+    later (``finished``, UTC), else the later line (rows kept before rows had the time); a
+    line cut short by a stopped run is skipped. By time, a clone's older run merged after a
+    newer one does not replace it."""
     found: dict[str, dict] = {}
     if not path.exists():
         return found
     for line in path.read_text().splitlines():
         try:
             row = json.loads(line)
-            found[row["name"]] = row
+            name = row["name"]
         except (ValueError, KeyError, TypeError):
             continue
+        kept = found.get(name)
+        if kept is None or not (kept.get("finished") and row.get("finished")
+                                and row["finished"] < kept["finished"]):
+            found[name] = row
     return found
 
 
 def merge_results(path: Path, others: list[Path]) -> int:
     """Append to ``path`` every run line of ``others`` that it does not hold (the same line),
-    in their order: copies of ``path`` that went on elsewhere add their newer runs, which win
-    as the later lines of their names. Returns the number of lines appended. Lines that are
+    in their order: copies of ``path`` that went on elsewhere add their runs, the newer of
+    which win (:func:`load_results`). Returns the number of lines appended. Lines that are
     not a run (cut short, not JSON) are skipped."""
     have = set(path.read_text().splitlines()) if path.exists() else set()
     new: list[str] = []
@@ -261,6 +268,7 @@ def main(argv: list[str]) -> int:
         row["commit"] = commit
         row["params"] = fingerprints[combo.name]
         row["speed_up"] = args.speed_up
+        row["finished"] = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
         run_dir = row.pop("run_dir", "")  # a temporary folder: not kept in the row
         if _stopped_half_way(row):  # a mission killed on its own is no result: run it again
             print(f"[-] {combo.name}: stopped before its end ({row['error']}), not kept",

@@ -219,7 +219,8 @@ def test_a_multi_line_error_keeps_its_first_line_in_the_table():
 
 def test_merging_a_clones_results_appends_its_newer_runs(tmp_path):
     """A clone that ran on from a copy of the results file: its extra runs are appended (and
-    win as the later lines of their names); what both hold, and lines cut short, are not."""
+    win as the later lines of their names, or by when they finished); what both hold, and lines
+    cut short, are not."""
     import json
 
     from run_matrix import load_results, merge_results
@@ -236,6 +237,14 @@ def test_merging_a_clones_results_appends_its_newer_runs(tmp_path):
     assert merge_results(main, [clone]) == 0  # nothing new the second time
     kept = load_results(main)
     assert {name: row["exit_code"] for name, row in kept.items()} == {"a": 0, "b": 0, "c": 0}
+    # Runs that say when they finished: the newer wins, whatever the order of the lines (a
+    # clone's older run merged after main's newer one).
+    newer = json.dumps({"name": "e", "exit_code": 0, "finished": "2026-11-30T08:00:00Z"})
+    older = json.dumps({"name": "e", "exit_code": 1, "finished": "2026-11-29T08:00:00Z"})
+    main.write_text(newer + "\n")
+    clone.write_text(older + "\n")
+    assert merge_results(main, [clone]) == 1
+    assert load_results(main)["e"]["exit_code"] == 0
 
 
 def test_two_maps_managers_side_by_side_only_where_a_plugin_needs_both():
