@@ -173,19 +173,3 @@ def test_turn_ahead_from_a_heading_and_on_degenerate_paths():
     # A U-turn is pi, whichever way round.
     u_turn = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.2], [0.0, 0.2]])
     assert turn_ahead(u_turn, np.array([0.5, 0.0]), 1.0) == pytest.approx(math.pi)
-
-
-def test_turned_at_the_goal_but_beyond_the_tolerance_it_approaches_again():
-    # The goal manager counts a goal reached within its position tolerance, on the estimate,
-    # which moves while the robot turns in place: stopped beyond it, the mission would wait.
-    follower = SimplePathFollower(look_ahead_dist=0.3, tolerance_dist=0.2,
-                                  final_goal_angle_tolerance=0.2)  # the goal manager's rule
-    path = np.array([(x, 0.0, 0.0) for x in np.arange(0.0, 3.01, 0.1)])
-    tol = {"position_tolerance": 0.15, "yaw_tolerance": 0.15}
-    v, w, state = follower.compute((2.9, 0.0, 1.0), path, 0.05, RobotLimits(), **tol)
-    assert state == FINAL_ROTATION and v == 0.0 and w < 0.0
-    v, w, state = follower.compute((2.84, 0.0, 0.0), path, 0.05, RobotLimits(), **tol)
-    assert state != ARRIVED  # turned, but the estimate now 0.16 m away
-    trace, states = simulate(follower, path, (2.84, 0.0, 0.0), **tol)
-    assert states[-1] == ARRIVED
-    assert math.hypot(trace[-1, 0] - 3.0, trace[-1, 1]) <= 0.15

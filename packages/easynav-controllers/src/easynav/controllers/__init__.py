@@ -9,6 +9,7 @@ imported here.
 from easynav.controllers.mpc_optimizer import MPCOptimizer
 from easynav.controllers.path_follower import (
     ARRIVED,
+    CREEPING_TO_GOAL,
     FINAL_ROTATION,
     FOLLOWING,
     NO_PATH,
@@ -21,6 +22,7 @@ from easynav.controllers.vff_vectors import VffVectors
 
 __all__ = [
     "ARRIVED",
+    "CREEPING_TO_GOAL",
     "FINAL_ROTATION",
     "FOLLOWING",
     "NO_PATH",

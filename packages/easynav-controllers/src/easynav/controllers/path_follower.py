@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from easynav.controllers.goal_arrival import ARRIVE, CREEP, TURN, GoalArrival
 from easynav.controllers.pid_controller import PIDController
 from easynav.controllers.regulated_pp.path_geometry import cusp_indices, project_on_path
 from easynav.core.robot import RobotLimits
@@ -15,6 +16,8 @@ from easynav.core.types import normalize_angle
 NO_PATH = "no_path"
 FOLLOWING = "following"
 FINAL_ROTATION = "final_rotation"
+#: Turned at the goal but beyond the stop distance: straight along the heading.
+CREEPING_TO_GOAL = "creeping_to_goal"
 ARRIVED = "arrived"
 
 
@@ -131,7 +134,10 @@ class SimplePathFollower:
     backwards, unless ``allow_reversing``). Within ``tolerance_dist`` of the last pose the robot
     stops and turns to its yaw
     (``FINAL_ROTATION``, kept until 2·``tolerance_dist`` so estimate noise does not toggle it),
-    then reports ``ARRIVED`` within ``final_goal_angle_tolerance`` and commands zero. Speeds are
+    then reports ``ARRIVED`` within ``final_goal_angle_tolerance`` and commands zero; turned but
+    beyond ``tolerance_dist`` (the estimate moved during the turn) it creeps straight along its
+    heading first (``CREEPING_TO_GOAL``; :class:`~easynav.controllers.goal_arrival.GoalArrival`
+    decides the end of the approach). Speeds are
     clamped to the robot limits and changed within their accelerations (speeding up) and
     decelerations (slowing down).
 
@@ -182,9 +188,7 @@ class SimplePathFollower:
         self.angular_pid = PIDController(*angular_gains, max_output=math.inf)
         self._v = 0.0
         self._w = 0.0
-        self._goal: tuple[float, float, float] | None = None
-        self._final_rotation = False
-        self._reapproach = False  # turned at the goal but beyond the stop distance: go nearer
+        self.arrival = GoalArrival()
         self._state = NO_PATH
         # The path being followed (its identity), its pieces between cusps, the current one.
         self._segments_of: np.ndarray | None = None
@@ -198,8 +202,7 @@ class SimplePathFollower:
         self.linear_pid.reset()
         self.angular_pid.reset()
         self._v = self._w = 0.0
-        self._goal = None
-        self._final_rotation = self._reapproach = False
+        self.arrival.reset()
         self._state = NO_PATH
 
     def _forget_path(self) -> None:
@@ -269,20 +272,12 @@ class SimplePathFollower:
             return self._v, self._w, self._state
         x, y, yaw = (float(v) for v in pose_xy_yaw)
         goal = (float(path[-1, 0]), float(path[-1, 1]), float(path[-1, 2]))
-        if (
-            self._goal is None
-            or max(abs(a - b) for a, b in zip(goal, self._goal, strict=True)) > 1e-6
-        ):
-            self._goal = goal  # a new goal: decide the final approach afresh
-            self._final_rotation = self._reapproach = False
         # Anti-windup: the integral terms may never ask for more than the robot can do (the
         # PIDs' outputs are saturated below, by these same limits).
         self.linear_pid.integral_limit = max(limits.max_linear_vel, 0.0)
         self.angular_pid.integral_limit = max(limits.max_angular_vel, 0.0)
         stop_dist = min(self.tolerance_dist, position_tolerance)
         stop_yaw = min(self.final_goal_angle_tolerance, yaw_tolerance)
-        dist_goal = math.hypot(goal[0] - x, goal[1] - y)
-        yaw_error = normalize_angle(goal[2] - yaw)
 
         piece, direction = self._active_segment(path, x, y)
         # A path with cusps may pass the goal before its last segment: not arrived there.
@@ -290,37 +285,37 @@ class SimplePathFollower:
         if not self.allow_reversing or limits.min_linear_vel >= 0.0:
             direction = 1  # this robot does not reverse: drive the segment forward
 
-        # The final rotation goes on up to twice the stop distance away (the estimate moves as
-        # the robot turns), but the robot is arrived only within it, at most the goal manager's
-        # tolerance: stopped beyond, the goal manager would wait for a goal it never sees
-        # reached. Turned but beyond it, the approach starts again, to half the stop distance.
-        if (self._final_rotation and dist_goal > stop_dist
-                and abs(yaw_error) <= stop_yaw):
-            self._final_rotation, self._reapproach = False, True
-        arrive = 0.5 * stop_dist if self._reapproach else stop_dist
-        if on_last and (
-            dist_goal <= arrive or (self._final_rotation and dist_goal <= 2.0 * stop_dist)
-        ):
-            self._reapproach = False
-            if not self._final_rotation:
-                # A new objective (the goal's yaw, not the carrot's bearing): the heading
-                # integral of the approach must not push the final turn.
-                self.angular_pid.reset()
-            self._final_rotation = True
+        # The end of the approach (the final rotation; arrived only within the stop distance,
+        # at most the goal manager's tolerance; a creep when turned beyond it): GoalArrival.
+        previous = self._state
+        action = self.arrival.decide(
+            (x, y, yaw), goal, stop_dist, stop_yaw,
+            can_reverse=self.allow_reversing and limits.min_linear_vel < 0.0, near_end=on_last,
+        )
+        kind = action[0] if action is not None else None
+        if (kind == TURN) != (previous == FINAL_ROTATION):
+            # A new objective (the goal's yaw, or the carrot's bearing again): the heading
+            # integral and derivative of the other one must not push this one.
+            self.angular_pid.reset()
+        if kind == ARRIVE:
             self.linear_pid.reset()
-            if abs(yaw_error) <= stop_yaw:
-                self.angular_pid.reset()
-                self._v = self._w = 0.0
-                self._state = ARRIVED
-                return 0.0, 0.0, ARRIVED
+            self.angular_pid.reset()
+            self._v = self._w = 0.0
+            self._state = ARRIVED
+            return 0.0, 0.0, ARRIVED
+        if kind == TURN:
+            self.linear_pid.reset()
             v_target = 0.0
-            w_target = self.angular_pid.output(yaw_error, dt)
+            w_target = self.angular_pid.output(action[1], dt)
             # The dead band must not hold the robot short of a tighter goal tolerance.
             if w_target == 0.0:
-                w_target = math.copysign(min(0.1, limits.max_angular_vel), yaw_error)
+                w_target = math.copysign(min(0.1, limits.max_angular_vel), action[1])
             state = FINAL_ROTATION
+        elif kind == CREEP:
+            self.linear_pid.reset()
+            v_target, w_target = action[1], 0.0
+            state = CREEPING_TO_GOAL
         else:
-            self._final_rotation = False
             carrot = carrot_on_path(piece[:, :2], np.array((x, y)), self.look_ahead_dist)
             dx, dy = carrot[0] - x, carrot[1] - y
             # In reverse the robot's back leads: it steers its back towards the carrot.

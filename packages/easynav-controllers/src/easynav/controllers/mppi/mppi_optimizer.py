@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from easynav.controllers.goal_arrival import CREEP, TURN, GoalArrival
 from easynav.controllers.mppi.collision_model import CollisionModel
 from easynav.controllers.mppi.critic import Critic
 from easynav.controllers.mppi.critics import CRITICS, DEFAULT_CRITICS
@@ -101,6 +102,8 @@ FALLBACK = "fallback"
 #: Every candidate collided: braking.
 BLOCKED = "blocked"
 ROTATING_TO_GOAL = "rotating_to_goal"
+#: Turned at the goal but beyond its position tolerance: straight along the heading.
+CREEPING_TO_GOAL = "creeping_to_goal"
 ROTATING_TO_HEADING = "rotating_to_heading"
 ARRIVED = "arrived"
 
@@ -208,8 +211,7 @@ class MppiOptimizer:
         self._path = np.zeros((0, 3))
         self._s = np.zeros(0)
         self._segment = 0
-        self._at_goal_xy = False
-        self._reapproach = False  # turned at the goal but beyond its tolerance: go nearer
+        self.arrival = GoalArrival()
         self._rotating = False
         self._rotation_sign = 0.0
         self._blocked_sign = 0.0  # the latch of the turn in place when blocked
@@ -265,35 +267,32 @@ class MppiOptimizer:
             lengths = np.hypot(*np.diff(self._path[:, :2], axis=0).T)
             self._s = np.concatenate(([0.0], np.cumsum(lengths)))
             self._segment = -1
-            self._at_goal_xy = self._reapproach = False
         x0, y0, yaw0 = pose
         dt = p["dt"]
         max_v = max(limits.max_linear_vel, 0.0)
         max_w = max(limits.max_angular_vel, 0.0)
         goal = tuple(float(v) for v in self._path[-1])
         goal_dist = math.hypot(goal[0] - x0, goal[1] - y0)
-        # Within the position tolerance the robot turns to the goal's yaw, and goes on turning
-        # up to twice the tolerance away (the estimate moves as it turns); but it stops,
-        # arrived, only within the tolerance, the goal manager's: stopped beyond it, the goal
-        # manager waits for a goal it never sees reached (seen in the matrix: stopped 0.16 m
-        # from a goal with a 0.15 m tolerance, for 95 s, until the estimate's noise once came
-        # within it). Turned but beyond it, it approaches again, to half the tolerance (not to
-        # its border, where the next turn could leave it out again).
-        arrive = 0.5 * xy_tolerance if self._reapproach else xy_tolerance
-        if goal_dist <= arrive or (self._at_goal_xy and goal_dist <= 2.0 * xy_tolerance):
-            error = self._latch(normalize_angle(goal[2] - yaw0))
-            if abs(error) > yaw_tolerance or goal_dist <= xy_tolerance:
-                self._at_goal_xy, self._reapproach = True, False
-                self.sequence[:] = 0.0
-                if abs(error) <= yaw_tolerance:
-                    self._rotation_sign = 0.0
-                    return self._apply(0.0, 0.0, ARRIVED)
+        # The end of the approach (turn to the goal's yaw, arrive only within the goal
+        # manager's tolerance, creep when turned beyond it): GoalArrival decides.
+        was_turning = self.arrival.turning
+        action = self.arrival.decide(pose, goal, xy_tolerance, yaw_tolerance,
+                                     can_reverse=limits.min_linear_vel < 0.0)
+        if action is not None:
+            self.sequence[:] = 0.0
+            kind, value = action
+            if kind == TURN:
+                if not was_turning:  # a new turn: not the way a turn to the path went
+                    self._rotation_sign, self._rotating = 0.0, False
+                error = self._latch(value)
                 w = rotation_speed(error, self.last[1], elapsed, max_w, limits.max_angular_acc,
                                    limits.max_angular_decel, max_w)
                 return self._apply(0.0, w, ROTATING_TO_GOAL)
             self._rotation_sign = 0.0
-            self._reapproach = True
-        self._at_goal_xy = False
+            if kind == CREEP:
+                return self._apply(min(max(value, limits.min_linear_vel), max_v), 0.0,
+                                   CREEPING_TO_GOAL)
+            return self._apply(0.0, 0.0, ARRIVED)
 
         rollout_reach = max(max_v, abs(limits.min_linear_vel)) * steps * dt
         path_xy, path_yaw, path_s, is_final = self._local_path(

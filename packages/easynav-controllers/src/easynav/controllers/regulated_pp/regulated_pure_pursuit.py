@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from easynav.controllers.goal_arrival import CREEP, TURN, GoalArrival
 from easynav.controllers.regulated_pp.dynamic_window import select_command, velocity_window
 from easynav.controllers.regulated_pp.path_geometry import (
     carrot_point,
@@ -30,7 +31,7 @@ from easynav.controllers.regulated_pp.regulation import (
 )
 from easynav.core.plugins import Param
 from easynav.core.robot import RobotLimits
-from easynav.core.types import Costmap2D, normalize_angle
+from easynav.core.types import Costmap2D
 
 NAN = math.nan
 
@@ -107,6 +108,8 @@ NO_PATH = "no_path"
 FOLLOWING = "following"
 ROTATING_TO_HEADING = "rotating_to_heading"
 ROTATING_TO_GOAL = "rotating_to_goal"
+#: Turned at the goal but beyond its position tolerance: straight along the heading.
+CREEPING_TO_GOAL = "creeping_to_goal"
 ARRIVED = "arrived"
 
 
@@ -126,7 +129,8 @@ class RegulatedPurePursuit:
     """Regulated Pure Pursuit with the original's parameters (see :data:`RPP_PARAMETERS`).
 
     Each call of :meth:`compute`: inside the goal's xy tolerance it rotates in place to the goal
-    yaw and stops within the yaw tolerance. Otherwise the carrot is the first point of the path
+    yaw and stops within the yaw tolerance (``GoalArrival``: turned but beyond the xy tolerance,
+    it creeps along its heading). Otherwise the carrot is the first point of the path
     ``lookahead`` away beyond the robot's projection (circle/segment intersection), the curvature
     ``2y/(x²+y²)`` in the robot frame; a carrot angle above ``rotate_to_heading_min_angle``
     starts a rotation in place that lasts until the angle is below half of it (hysteresis). The
@@ -159,8 +163,7 @@ class RegulatedPurePursuit:
         self._last = (0.0, 0.0)
         self._rotating = False
         self._rotation_sign = 0.0
-        self._at_goal_xy = False
-        self._reapproach = False  # turned at the goal but beyond its tolerance: go nearer
+        self.arrival = GoalArrival()
 
     @property
     def last_command(self) -> tuple[float, float]:
@@ -174,7 +177,6 @@ class RegulatedPurePursuit:
         self._s = np.concatenate(([0.0], np.cumsum(lengths)))
         self._cusps = cusp_indices(self._path_xy)
         self._segment = -1
-        self._at_goal_xy = self._reapproach = False
 
     def _active_end(self, allow_reversing: bool) -> int:
         """The last vertex of the part being followed: the next cusp, else the goal."""
@@ -251,26 +253,24 @@ class RegulatedPurePursuit:
         )
         seg, t, projection, end = self._track(position, lookahead, allow_reversing)
         final_part = end == len(self._path_xy) - 1
-        goal_dist = math.hypot(goal[0] - x, goal[1] - y)
-        # The turn to the goal's yaw goes on up to twice the position tolerance away (the
-        # estimate moves as the robot turns), but the robot is arrived only within it, the goal
-        # manager's tolerance: stopped beyond it, the goal manager would wait for ever. Turned
-        # but beyond it, the robot approaches again, to half the tolerance.
-        arrive = 0.5 * xy_tolerance if self._reapproach else xy_tolerance
-        if final_part and (goal_dist <= arrive or
-                           (self._at_goal_xy and goal_dist <= 2.0 * xy_tolerance)):
-            error = self._latch(normalize_angle(float(goal[2]) - yaw))
-            if abs(error) > yaw_tolerance or goal_dist <= xy_tolerance:
-                self._at_goal_xy, self._reapproach = True, False
-                if abs(error) <= yaw_tolerance:
-                    self._rotation_sign = 0.0
-                    return self._out(0.0, 0.0, ARRIVED)
+        # The end of the approach (turn to the goal's yaw, arrive only within the goal
+        # manager's tolerance, creep when turned beyond it): GoalArrival decides.
+        was_turning = self.arrival.turning
+        action = self.arrival.decide(pose, goal, xy_tolerance, yaw_tolerance,
+                                     can_reverse=min_v < 0.0, near_end=final_part)
+        if action is not None:
+            kind, value = action
+            if kind == TURN:
+                if not was_turning:  # a new turn: not the way a turn to the path went
+                    self._rotation_sign, self._rotating = 0.0, False
+                error = self._latch(value)
                 w = rotation_speed(error, self._last[1], dt, p["rotate_to_heading_angular_vel"],
                                    limits.max_angular_acc, limits.max_angular_decel, max_w)
                 return self._out(0.0, w, ROTATING_TO_GOAL)
             self._rotation_sign = 0.0
-            self._reapproach = True
-        self._at_goal_xy = False
+            if kind == CREEP:
+                return self._out(min(max(value, min_v), max_v), 0.0, CREEPING_TO_GOAL)
+            return self._out(0.0, 0.0, ARRIVED)
 
         carrot = carrot_point(self._path_xy, position, seg + 1, end, lookahead,
                               first_point=projection)
