@@ -562,9 +562,9 @@ TIMEOUT_PER_METRE = 6.0
 MIN_TIMEOUT = 600.0
 
 
-#: CI's slice drives each world's tour this far at most (the start, then each waypoint, in
-#: straight lines; the first waypoint at least): home's whole tour (17 m) and the campus's first
-#: leg (30 m), where the whole campus tour (190 m) would take 4 to 8 minutes a row.
+#: CI's slice drives the legs of each world's tour that fit in this far (the start, then each
+#: waypoint, in straight lines; the first leg at least): home's whole tour (15 m) and the
+#: campus's first leg (30 m), where the whole campus tour (180 m) takes 4 to 8 minutes a row.
 SLICE_TOUR_METRES = 40.0
 
 
@@ -621,7 +621,11 @@ def run_combination(
     by default :func:`mission_timeout` of its world; ``waypoints``: only the first ones of the
     world's tour, None: all)."""
     from easynav.playground.demo import run_demo
-    from easynav.playground.world_description import WorldDescription, load_waypoints
+    from easynav.playground.world_description import (
+        WorldDescription,
+        load_waypoint_levels,
+        load_waypoints,
+    )
 
     run_dir.mkdir(parents=True, exist_ok=True)
     params = run_dir / "matrix.params.yaml"
@@ -631,6 +635,8 @@ def run_combination(
         tour = None
         if waypoints is not None:
             path = WorldDescription.resolve(combo.world).waypoints_path
+            if load_waypoint_levels(path):  # a list has no floors: a tour of floors runs whole
+                raise ValueError(f"{combo.world}'s tour has floors: it cannot be cut short")
             tour = load_waypoints(path)[:waypoints]
         # run_demo prints a usage error (a bad world, a params file it cannot read) to stderr:
         # a copy goes to ``out``, so that the row says it instead of "exit 2".
@@ -718,14 +724,15 @@ def markdown(outcomes: list[Outcome], header: str, unmatched: dict[str, str] | N
             f" | {_num(s.get('late_rt_cycles'), 'd')} | {o.ran or '—'} | "
             f"{verdict(o, findings).replace('|', '/')} |"
         )
-    green = sum(o.green for o in outcomes)
+    current = [o for o in outcomes if not o.stale]
+    green = sum(o.green for o in current)
     explained = sum(not o.green and any(f.explains(o.combination) for f in findings)
-                    for o in outcomes)
-    stale = sum(o.stale for o in outcomes)
-    lines += ["", f"{green} of {len(outcomes)} runs green; of the {len(outcomes) - green} "
+                    for o in current)
+    stale = len(outcomes) - len(current)
+    lines += ["", f"{green} of {len(current)} runs green; of the {len(current) - green} "
               f"failed, {explained} explained (tests/matrix/findings.yaml)"
-              + (f"; {stale} stale (run with params changed since: to run again)" if stale
-                 else "") + ".", ""]
+              + (f"; and {stale} stale runs (run with params changed since: to run again)"
+                 if stale else "") + ".", ""]
     if unmatched:
         lines += ["Installed navigation plugins in no combination (nothing to run them with):", ""]
         lines += [f"- `{name}`: {reason}" for name, reason in sorted(unmatched.items())]

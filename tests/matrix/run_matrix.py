@@ -20,8 +20,9 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
              docs/matrix.md is written from the file; each row names the commit it ran.
   --fresh    forget the results file first
   --only S   only the combinations whose name contains one of the comma-separated S
-  --again S  run again the kept runs whose name contains one of the comma-separated S (a row
-             that failed at x2, run again at x1: --again NAME --speed-up 1); the new run wins
+  --again S  run only the combinations whose name contains one of the comma-separated S, kept
+             or not (a row that failed at x2, run again at x1: --again NAME --speed-up 1); the
+             new run wins
   --list     print the combinations and exit
   --report   write docs/matrix.md from the results file without running anything
   --merge F  append to the results file the runs that results files F... (copies of it that
@@ -246,10 +247,12 @@ def main(argv: list[str]) -> int:
                     if not args.report or c.name in kept}
     stale = stale_rows(combos, kept, fingerprints)
     again = [part for part in args.again.split(",") if part]
-    todo = [] if args.report else [
-        c for c in combos
-        if c.name not in kept or c.name in stale or any(part in c.name for part in again)
-    ]
+    if args.report:
+        todo = []
+    elif again:
+        todo = [c for c in combos if any(part in c.name for part in again)]
+    else:
+        todo = [c for c in combos if c.name not in kept or c.name in stale]
     done_before = sum(c.name in kept for c in combos) - len(stale)
     print(f"{len(combos)} combinations: {done_before} done in {results_path}, {len(stale)} "
           f"kept there with other params (run again), {len(todo)} to run, {args.jobs} at a time",
@@ -317,9 +320,10 @@ def main(argv: list[str]) -> int:
         "Written by `make matrix` (tests/matrix/run_matrix.py): every compatible combination of "
         "the installed maps managers, localizers, planners and controllers (compatibility as the "
         "plugins declare it) in each world, each a waypoint mission of the playground. CI runs "
-        "the combinations that together use every plugin at least once (`--slice`), each in "
-        "the first world that suits it (home, the campus for the plugins that need its "
-        "sensors), on the first 40 m of that world's tour. Each plugin is configured "
+        "the combinations that together use every plugin at least once (`--slice` lists them), "
+        "each in the first world that suits it (home, the campus for the plugins that need its "
+        "sensors), on the legs of that world's tour that fit in its first 40 m (home's whole "
+        "tour, the campus's first leg). Each plugin is configured "
         "as in a params file written for the row's world where there is one (`# Run: ... "
         "--world NAME`: the tb3_sandbox's costmap files, the depot's costmap with its keepout "
         "and speed zones, the campus's files for the Simple* plugins), else as in the "
@@ -356,7 +360,8 @@ def main(argv: list[str]) -> int:
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     Path(args.output).write_text(markdown(outcomes, header, unmatched, findings))
     print(f"wrote {args.output}")
-    return 0 if len(outcomes) == len(combos) and all(o.green for o in outcomes) else 1
+    return 0 if len(outcomes) == len(combos) and all(
+        o.green and not o.stale for o in outcomes) else 1
 
 
 if __name__ == "__main__":

@@ -205,8 +205,32 @@ def test_the_report_marks_a_stale_row_and_says_what_each_row_ran_with():
     assert verdict(stale) == "green (**stale**: run with params changed since; to run again)"
     text = markdown([stale, fresh], "# header")
     assert "| 11a8747 x2 | green (**stale**" in text and "| 3b39a3e x1 | green |" in text
-    assert "2 of 2 runs green; of the 0 failed, 0 explained (tests/matrix/findings.yaml); " \
-           "1 stale (run with params changed since: to run again)." in text
+    assert "1 of 1 runs green; of the 0 failed, 0 explained (tests/matrix/findings.yaml); " \
+           "and 1 stale runs (run with params changed since: to run again)." in text
+
+
+def test_again_runs_only_the_rows_it_names(tmp_path, monkeypatch):
+    import json
+
+    import run_matrix
+
+    combos = combinations(("home",))
+    named, other = combos[0], combos[1]  # both kept, other stale: only the named one runs
+    results = tmp_path / "results.jsonl"
+    results.write_text("".join(json.dumps(
+        {"name": c.name, "exit_code": 0, "summary": {"success": True}, "error": "",
+         "params": run_matrix.params_fingerprint(c) if c is named else "retuned"}) + "\n"
+        for c in (named, other)))
+    ran = []
+
+    def run(name, run_dir, args):
+        ran.append(name)
+        return {"name": name, "exit_code": 0, "summary": {"success": True}, "error": ""}
+
+    monkeypatch.setattr(run_matrix, "_run_in_process", run)
+    run_matrix.main(["--worlds", "home", "--again", named.name, "--results", str(results),
+                     "--output", str(tmp_path / "matrix.md")])
+    assert ran == [named.name]
 
 
 def test_a_multi_line_error_keeps_its_first_line_in_the_table():
