@@ -19,10 +19,11 @@ for a goal that is never reached. So, once the robot is within the position tole
    then, if that was not enough, to a quarter of it, and so on to a sixteenth (an estimate off
    the robot's centre lands the nearer after the turn, the nearer the approach ended).
 
-A limit: a robot that cannot reverse, whose estimate sits well off its centre (more than a
-third of the tolerance) and whose goal faces back along its approach, turns at the goal, finds
-it behind, approaches again and turns again: a systematic offset of the estimate is a wrong
-sensor frame to fix, not noise a controller can absorb.
+A limit: an estimate that sits off the robot's centre by about the tolerance or more (a sensor
+frame a few centimetres wrong, with the spec's 0.03 m tolerance) can keep any robot turning and
+approaching again, a forward-only one as soon as it is more than a third of the tolerance and
+the goal faces back along the approach: a systematic offset is a wrong frame to fix, not noise a
+controller can absorb.
 
 The controller keeps its own ways of turning and of approaching; this class only decides which.
 """
@@ -50,9 +51,13 @@ CREEP_DONE = 0.01
 #: The creep is tried when the goal is at most this share of the tolerance off the heading's line:
 #: it then ends within the tolerance with a margin.
 CREEP_LATERAL = 0.7
-#: The turn to the goal's yaw goes on while the robot is within this many tolerances of it.
+#: The turn to the goal's yaw goes on while the robot is within this many tolerances of it, plus
+#: TURN_MARGIN (m): an estimate off the robot's centre moves by twice that offset in a half turn,
+#: whatever the tolerance. Leaving the band counts as an approach that did not do.
 TURN_BAND = 3.0
-#: Each approach again ends twice as near as the previous one, down to the tolerance over this.
+TURN_MARGIN = 0.1
+#: Each approach again ends twice as near as the previous one, down to the tolerance over this
+#: (and never nearer than the controller's ``min_arrival_radius``).
 MAX_REAPPROACH_DIVISOR = 16.0
 
 
@@ -62,7 +67,11 @@ class GoalArrival:
     Thread contract: used by one controller in its RT thread; not thread-safe.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, min_arrival_radius: float = 0.0) -> None:
+        """``min_arrival_radius`` (m): an approach again never aims nearer, where the
+        controller's own dead band would hold it short (the path follower's distance PID
+        ignores a centimetre)."""
+        self.min_arrival_radius = float(min_arrival_radius)
         self._goal: tuple[float, float, float] | None = None
         self.reset()
 
@@ -112,8 +121,10 @@ class GoalArrival:
         if not near_end:
             self.turning = False
             return None
-        if dist <= xy_tolerance / self.divisor or (
-            self.turning and dist <= TURN_BAND * xy_tolerance
+        arrival_radius = min(xy_tolerance,
+                             max(xy_tolerance / self.divisor, self.min_arrival_radius))
+        if dist <= arrival_radius or (
+            self.turning and dist <= TURN_BAND * xy_tolerance + TURN_MARGIN
         ):
             self.turning = True
             if abs(yaw_error) > yaw_tolerance:
@@ -127,7 +138,9 @@ class GoalArrival:
             self.turning = False
             self._approach_again()
             return None
-        self.turning = False
+        if self.turning:  # the turn left the band: an approach that did not do
+            self.turning = False
+            self._approach_again()
         return None
 
     @property
@@ -141,3 +154,12 @@ class GoalArrival:
 
 def _creep_speed(along: float) -> float:
     return math.copysign(min(CREEP_SPEED, max(CREEP_MIN_SPEED, CREEP_GAIN * abs(along))), along)
+
+
+def creep_command(speed: float, last: float, dt: float, limits) -> float:
+    """The creep's ``speed`` within the robot's speeds, and changed from the ``last`` command
+    within its acceleration (away from zero) or deceleration (towards zero) over ``dt``."""
+    speed = min(max(speed, min(limits.min_linear_vel, 0.0)), max(limits.max_linear_vel, 0.0))
+    rate = limits.max_linear_acc if abs(speed) > abs(last) else limits.max_linear_decel
+    step = max(rate, 0.0) * max(dt, 0.0)
+    return min(max(speed, last - step), last + step)

@@ -188,7 +188,8 @@ class SimplePathFollower:
         self.angular_pid = PIDController(*angular_gains, max_output=math.inf)
         self._v = 0.0
         self._w = 0.0
-        self.arrival = GoalArrival()
+        # An approach again never aims nearer than the distance PID's dead band lets it drive.
+        self.arrival = GoalArrival(min_arrival_radius=1.5 * self.linear_pid.dead_band)
         self._state = NO_PATH
         # The path being followed (its identity), its pieces between cusps, the current one.
         self._segments_of: np.ndarray | None = None

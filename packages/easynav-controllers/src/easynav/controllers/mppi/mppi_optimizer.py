@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from easynav.controllers.goal_arrival import CREEP, TURN, GoalArrival
+from easynav.controllers.goal_arrival import CREEP, TURN, GoalArrival, creep_command
 from easynav.controllers.mppi.collision_model import CollisionModel
 from easynav.controllers.mppi.critic import Critic
 from easynav.controllers.mppi.critics import CRITICS, DEFAULT_CRITICS
@@ -290,8 +290,8 @@ class MppiOptimizer:
                 return self._apply(0.0, w, ROTATING_TO_GOAL)
             self._rotation_sign = 0.0
             if kind == CREEP:
-                return self._apply(min(max(value, limits.min_linear_vel), max_v), 0.0,
-                                   CREEPING_TO_GOAL)
+                v = creep_command(value, self.last[0], elapsed, limits)
+                return self._apply(v, 0.0, CREEPING_TO_GOAL)
             return self._apply(0.0, 0.0, ARRIVED)
 
         rollout_reach = max(max_v, abs(limits.min_linear_vel)) * steps * dt

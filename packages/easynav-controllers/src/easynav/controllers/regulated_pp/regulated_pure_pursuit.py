@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from easynav.controllers.goal_arrival import CREEP, TURN, GoalArrival
+from easynav.controllers.goal_arrival import CREEP, TURN, GoalArrival, creep_command
 from easynav.controllers.regulated_pp.dynamic_window import select_command, velocity_window
 from easynav.controllers.regulated_pp.path_geometry import (
     carrot_point,
@@ -269,7 +269,8 @@ class RegulatedPurePursuit:
                 return self._out(0.0, w, ROTATING_TO_GOAL)
             self._rotation_sign = 0.0
             if kind == CREEP:
-                return self._out(min(max(value, min_v), max_v), 0.0, CREEPING_TO_GOAL)
+                v = min(max(creep_command(value, self._last[0], dt, limits), min_v), max_v)
+                return self._out(v, 0.0, CREEPING_TO_GOAL)
             return self._out(0.0, 0.0, ARRIVED)
 
         carrot = carrot_point(self._path_xy, position, seg + 1, end, lookahead,
