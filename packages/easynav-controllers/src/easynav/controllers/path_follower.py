@@ -133,7 +133,8 @@ class SimplePathFollower:
     ``v = max(0, PID_linear(distance to the carrot) - k_rot·|w|)`` (slower while turning; never
     backwards, unless ``allow_reversing``). Within ``tolerance_dist`` of the last pose the robot
     stops and turns to its yaw
-    (``FINAL_ROTATION``, kept until 2·``tolerance_dist`` so estimate noise does not toggle it),
+    (``FINAL_ROTATION``, kept up to 3·``tolerance_dist`` + 0.1 m away, so that the estimate's
+    moves during the turn do not toggle it),
     then reports ``ARRIVED`` within ``final_goal_angle_tolerance`` and commands zero; turned but
     beyond ``tolerance_dist`` (the estimate moved during the turn) it creeps straight along its
     heading first (``CREEPING_TO_GOAL``; :class:`~easynav.controllers.goal_arrival.GoalArrival`
