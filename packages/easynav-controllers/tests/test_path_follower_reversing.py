@@ -229,3 +229,24 @@ def test_the_simple_controller_passes_the_parameters_to_its_follower():
     assert controller.follower.allow_reversing and controller.follower.cusp_tolerance == 0.2
     controller.apply_parameter("allow_reversing", False)
     assert not controller.follower.allow_reversing
+
+
+def test_a_short_reverse_at_the_end_of_a_path_does_not_skip_the_way_there():
+    # A Reeds–Shepp path as OMPL planned it on the depot: west, north, east, then a few
+    # centimetres of reverse into the goal. The robot at the start lies beyond the line of the
+    # last step before that cusp; it skipped to the last piece and drove straight at the goal,
+    # through a wall. It must follow the way there first.
+    west = [(x, 0.0, math.pi) for x in np.arange(0.0, -5.0, -0.1)]
+    north = [(-5.0, y, math.pi / 2) for y in np.arange(0.0, 5.1, 0.1)]
+    east = [(x, 5.1, 0.0) for x in np.arange(-5.0, 4.95, 0.1)]
+    # The last step before the cusp heads south-east: the start lies beyond its line.
+    tail = [(5.0, 5.1, 0.0), (5.02, 5.05, -1.2), (5.0, 5.1, 1.57)]
+    path = np.array(west + north + east + tail)
+    assert len(cusp_pieces(path[:, :2])) >= 2
+    forward_only = replace(RobotLimits(), min_linear_vel=0.0)
+    trace, arrived = simulate(SimplePathFollower(look_ahead_dist=0.3), path, (0.0, 0.0, math.pi),
+                              limits=forward_only, seconds=90.0)
+    # It drove the way there: west first, then north, never cutting across to the goal.
+    assert trace[:, 0].min() < -4.5 and trace[:, 1].max() > 4.5
+    assert trace[int(5.0 * 30), 0] < -1.0  # 5 s in: going west, not towards (5, 5)
+    assert arrived

@@ -232,7 +232,11 @@ class SimplePathFollower:
                 (k for k, (first, last, _) in enumerate(self._segments) if nearest < last), 0
             )
         # Past a cusp once the robot is close enough to it, or beyond it along the piece's last
-        # step (never back: the path may pass the same place in both directions).
+        # step while that step is the piece's nearest to the robot (never back: the path may pass
+        # the same place in both directions). Not beyond the line of that step alone: a
+        # Reeds–Shepp path ending with a few centimetres of reverse put a robot 13 m away, on
+        # the far side of that line, on the last piece, and it drove straight at the goal
+        # through a wall (the depot, OMPL Reeds–Shepp + SimpleController).
         while self._segment < len(self._segments) - 1:
             first, last, _ = self._segments[self._segment]
             to_robot = (x - path[last, 0], y - path[last, 1])
@@ -240,7 +244,11 @@ class SimplePathFollower:
                 moving = np.flatnonzero(np.any(np.diff(path[first : last + 1, :2], axis=0), axis=1))
                 if len(moving) == 0:
                     break
-                step = path[first + moving[-1] + 1, :2] - path[first + moving[-1], :2]
+                last_step = first + moving[-1]
+                nearest, _, _ = project_on_path(path[:, :2], np.array((x, y)), first, last)
+                if nearest < last_step:
+                    break  # nearer an earlier part of the piece: still on the way to the cusp
+                step = path[last_step + 1, :2] - path[last_step, :2]
                 if to_robot[0] * step[0] + to_robot[1] * step[1] < 0.0:
                     break  # still short of the cusp
             self._segment += 1
