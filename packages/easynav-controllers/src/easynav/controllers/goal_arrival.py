@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 
+from easynav.controllers.command_limits import limit_command
 from easynav.core.types import normalize_angle
 
 #: What the controller does this cycle (see :meth:`GoalArrival.decide`).
@@ -158,8 +159,6 @@ def _creep_speed(along: float) -> float:
 
 def creep_command(speed: float, last: float, dt: float, limits) -> float:
     """The creep's ``speed`` within the robot's speeds, and changed from the ``last`` command
-    within its acceleration (away from zero) or deceleration (towards zero) over ``dt``."""
-    speed = min(max(speed, min(limits.min_linear_vel, 0.0)), max(limits.max_linear_vel, 0.0))
-    rate = limits.max_linear_acc if abs(speed) > abs(last) else limits.max_linear_decel
-    step = max(rate, 0.0) * max(dt, 0.0)
-    return min(max(speed, last - step), last + step)
+    within its acceleration (away from zero) or deceleration (towards zero) over ``dt``
+    (:func:`~easynav.controllers.command_limits.limit_command`, the linear part)."""
+    return limit_command(speed, 0.0, last, 0.0, dt, limits)[0]
