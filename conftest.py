@@ -19,3 +19,50 @@ if importlib.util.find_spec("easynav.system") is not None:
         "easynav.system.testing.ros_fixtures",
         "easynav.system.testing.system_fixtures",
     ]
+
+
+# The machine's load during the run, at the end of the report: a timing test that failed on a
+# machine busy with other work (another test run, a matrix mission, a neighbour on the
+# hypervisor) says so here. Linux only (/proc/stat); the controller process only, not xdist's
+# workers (whose CPU time it counts, as its children).
+def _cpu_seconds() -> tuple[float, float, float, float] | None:
+    """Machine-wide busy, idle and stolen CPU seconds (/proc/stat), and this process tree's."""
+    import resource
+
+    try:
+        with open("/proc/stat") as stat:
+            fields = [int(value) for value in stat.readline().split()[1:]]
+    except (OSError, ValueError):
+        return None
+    tick = os.sysconf("SC_CLK_TCK")
+    idle = (fields[3] + fields[4]) / tick  # idle + iowait
+    steal = fields[7] / tick if len(fields) > 7 else 0.0
+    busy = sum(fields[:8]) / tick - idle - steal  # user .. softirq (guest is inside user)
+    own = sum(resource.getrusage(who).ru_utime + resource.getrusage(who).ru_stime
+              for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return busy, idle, steal, own
+
+
+_cpu_at_start: list = []
+
+
+def pytest_sessionstart(session) -> None:
+    if not hasattr(session.config, "workerinput"):
+        _cpu_at_start.append(_cpu_seconds())
+
+
+def pytest_terminal_summary(terminalreporter, config) -> None:
+    start = _cpu_at_start[0] if _cpu_at_start else None
+    end = _cpu_seconds()
+    if start is None or end is None:
+        return
+    busy, idle, steal, own = (b - a for a, b in zip(start, end, strict=True))
+    total = busy + idle + steal
+    if total <= 0:
+        return
+    others = max(0.0, busy - own)
+    terminalreporter.write_line(
+        f"machine during the tests: {os.cpu_count()} CPUs, {100 * busy / total:.0f}% busy "
+        f"(these tests {100 * min(own, busy) / total:.0f}%, other processes "
+        f"{100 * others / total:.0f}%), {100 * steal / total:.0f}% stolen by the hypervisor"
+    )
