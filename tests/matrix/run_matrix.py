@@ -31,9 +31,10 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
              finished later counts). Merge a clone's file before resetting that clone, or its
              runs are lost
 
-A failed row's verdict says what a user would notice first (collisions, waypoints missed, the
-run's message) and, when the failure was looked into, why: tests/matrix/findings.yaml lists the
-causes found, each for the rows it explains; a failure nobody looked into says so.
+A failed row's verdict says what a user would notice first (collisions, waypoints missed, a
+lost localisation, the run's message) and, when the failure was looked into, why:
+tests/matrix/findings.yaml lists the causes found, each for the rows it explains; a failure
+nobody looked into says so.
 """
 
 from __future__ import annotations
@@ -59,12 +60,14 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from matrix import (  # noqa: E402 (the folder is not a package)
+    LOST_LOCALISATION,
     ROOT,
     WORLDS,
     Outcome,
     combinations,
     compose_params,
     covering_slice,
+    failure,
     load_findings,
     markdown,
     run_combination,
@@ -282,11 +285,12 @@ def main(argv: list[str]) -> int:
                 f.write(json.dumps(row) + "\n")
             kept[combo.name] = row
             finished[0] += 1
-            green = row["exit_code"] == 0 and row["summary"].get("success")
-            verdict = "green" if green else f"FAILED ({row['error']}; the run: {run_dir})"
-            if green:  # its logs and picture are kept for failures only (2.5 MB a run)
+            outcome = Outcome(combo, row["exit_code"], row["summary"], row["error"])
+            said = ("green" if outcome.green
+                    else f"FAILED ({failure(outcome)}; the run: {run_dir})")
+            if outcome.green:  # its logs and picture are kept for failures only (2.5 MB a run)
                 shutil.rmtree(work / f"{i:03d}", ignore_errors=True)
-            print(f"[{finished[0]}/{len(todo)}] {combo.name}: {verdict} ({row['seconds']:.0f} s)",
+            print(f"[{finished[0]}/{len(todo)}] {combo.name}: {said} ({row['seconds']:.0f} s)",
                   flush=True)
 
     # SIGTERM (a job's time limit, `kill`) stops it the way Ctrl-C does.
@@ -335,7 +339,9 @@ def main(argv: list[str]) -> int:
         "every computation takes twice as long in simulated time. A row that fails so is run "
         "again at x1 before it is looked into. Columns: the time of the mission is simulated; "
         "the minimum clearance is the robot's over the mission; the localisation error is "
-        "EasyNav's estimate against the truth over the whole run, from its first estimate; "
+        "EasyNav's estimate against the truth over the whole run, from its first estimate (a "
+        f"row whose error ever exceeds {LOST_LOCALISATION:g} m fails: the robot was lost, even "
+        "if it got there); "
         "late RT cycles (EasyNav's heartbeat) are those that started more than "
         "`safety.rt_monitor.max_period_factor` (2) periods after the previous one, from "
         "EasyNav's activation on; run: the commit and the speed-up the row ran with. A row "

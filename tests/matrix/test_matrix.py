@@ -335,6 +335,27 @@ def test_a_failed_row_says_why_when_a_finding_explains_it():
     assert "1 of 2 runs green; of the 1 failed, 1 explained" in text
 
 
+def test_a_row_whose_localisation_was_lost_fails_though_every_waypoint_was_reached():
+    combo = Combination("m/M", "l/L", "p/P", "c/C", "campus")
+    lost = Outcome(combo, 0, {"success": True, "waypoints": 5, "reached": 5,
+                              "localisation_mean": 23.9, "localisation_max": 88.7})
+    accurate = Outcome(combo, 0, {"success": True, "waypoints": 5, "reached": 5,
+                                  "localisation_mean": 0.39, "localisation_max": 0.93})
+    assert not lost.green and accurate.green
+    assert verdict(lost) == ("**FAILED** (not looked into yet): localisation lost: 88.7 m off "
+                             "at worst (mean 23.9 m, more than 2 m fails a row)")
+    assert "0 of 1 runs green; of the 1 failed" in markdown([lost], "# header")
+    # A run with no estimate (crashed first) has no error to judge; one that also hit
+    # something says so first.
+    assert Outcome(combo, 0, {"success": True, "localisation_max": None}).green
+    crashed = Outcome(combo, 1, {"collisions": 2, "waypoints": 5, "reached": 4,
+                                 "localisation_max": 3.26}, "no result within 600 s")
+    assert verdict(crashed) == (
+        "**FAILED** (not looked into yet): 2 collision(s); 4 of 5 waypoints reached; "
+        "localisation lost: 3.3 m off at worst (mean — m, more than 2 m fails a row); "
+        "no result within 600 s")
+
+
 def test_the_shipped_findings_name_installed_plugins_and_matrix_worlds():
     installed = {name for names in navigation_plugins().values() for name in names}
     for finding in load_findings():
@@ -367,5 +388,5 @@ def test_slice_combination_completes_its_mission(combo: Combination, tmp_path):
     outcome = run_combination(combo, tmp_path, timeout=600.0,
                               waypoints=slice_waypoints(combo.world))
     summary = outcome.summary
-    assert outcome.green, f"{combo.name}: {outcome.error}\n{summary}"
+    assert outcome.green, f"{combo.name}: {verdict(outcome)}\n{summary}"
     assert summary["collisions"] == 0 and summary["reached"] == summary["waypoints"]
