@@ -66,6 +66,17 @@ def diagnostic(rt, name):
     return rt.nav_state.get_or(f"diagnostics.{name}", None)
 
 
+def node_clocks(rt) -> str:
+    """Each EasyNav node's clock now (seconds), for failure messages."""
+    system_node = rt.system_node
+    nodes = [system_node, system_node.rt_io_node] + [
+        getattr(system_node, name) for name in (
+            "sensors_node", "maps_manager_node", "localizer_node", "planner_node",
+            "controller_node", "recovery_node")]
+    return ", ".join(f"{node.get_name()} {node.get_clock().now().nanoseconds * 1e-9:.3f}"
+                     for node in nodes)
+
+
 def stopped_after(driver, t: float) -> bool:
     """The last command received is an exact zero computed after ``t`` (node clock)."""
     return bool(driver.samples) and driver.samples[-1].stamp > t and driver.last().is_zero()
@@ -197,7 +208,15 @@ def test_after_the_clock_jumps_back_cmd_timeout_counts_from_the_jump(ros, start_
     nodes = ["system_node", "controller_node", "localizer_node", "planner_node",
              "maps_manager_node", "sensors_node", "recovery_node"]  # fmt: skip
     rt, driver = start(ros, start_easynav, **{f"{n}.use_sim_time": True for n in nodes})
-    assert ros.spin_until(lambda: driver.last_is(moving), timeout=5.0)
+    # This wait failed twice in about six full-suite runs, once on an idle machine (cause not
+    # found yet): the message says what each side saw, to find it next time.
+    assert ros.spin_until(lambda: driver.last_is(moving), timeout=5.0), (
+        f"no full-speed command within 5 s: {len(driver.samples)} received, the last "
+        f"{driver.samples[-1] if driver.samples else None}; the controller's last command "
+        f"{controller(rt).last_command}; cmd_vel diagnostic {diagnostic(rt, 'cmd_vel')}; "
+        f"simulated time {origin['sim'] + time.monotonic() - origin['mono']:.3f}, EasyNav's "
+        f"node clocks: {node_clocks(rt)}"
+    )
     assert driver.samples[-1].stamp >= 1000.0  # commands are stamped in simulated time
 
     jump_to = 990.0
