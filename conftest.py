@@ -38,8 +38,8 @@ def _cpu_seconds() -> tuple[float, float, float, float] | None:
     idle = (fields[3] + fields[4]) / tick  # idle + iowait
     steal = fields[7] / tick if len(fields) > 7 else 0.0
     busy = sum(fields[:8]) / tick - idle - steal  # user .. softirq (guest is inside user)
-    own = sum(resource.getrusage(who).ru_utime + resource.getrusage(who).ru_stime
-              for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    usages = [resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+    own = sum(usage.ru_utime + usage.ru_stime for usage in usages)
     return busy, idle, steal, own
 
 

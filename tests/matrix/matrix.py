@@ -692,9 +692,8 @@ def _num(value, fmt: str) -> str:
 
 def failure(outcome: Outcome) -> str:
     """What a user would notice first: collisions, goals missed, a lost localisation, then the
-    run's own message
-    (which can be the navigation's result, "Navigation successfully finished", when the
-    mission failed on a collision)."""
+    run's own message (which can be the navigation's result, "Navigation successfully
+    finished", when the mission failed on a collision)."""
     s = outcome.summary
     found = []
     if s.get("collisions"):
