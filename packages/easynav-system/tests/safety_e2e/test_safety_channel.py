@@ -18,7 +18,14 @@ from safety_e2e_harness import (
     full_speed,
     requires_sched_fifo,
 )
-from safety_e2e_params import ANGULAR_VEL, LIMITS, LINEAR_VEL, safety_mode_system, system
+from safety_e2e_params import (
+    ANGULAR_VEL,
+    LIMITS,
+    LINEAR_VEL,
+    RT_FREQ,
+    safety_mode_system,
+    system,
+)
 
 from easynav.core.types import DiagnosticLevel, Header, Pose, PoseStamped, Twist
 from easynav.system.goals.goal_client_state import GoalClientState
@@ -156,7 +163,6 @@ def test_safely_limited_speed_cuts_the_limits_down_and_is_reached_braking(ros, s
     controller_node = rt.system_node.controller_node
     controller = controller_node.plugins[0].plugin
 
-    limited_at = time.time()
     plc.limit_speed(0.1, 0.2, active_field="warning_field")
 
     def at_limit(twist) -> bool:
@@ -167,8 +173,14 @@ def test_safely_limited_speed_cuts_the_limits_down_and_is_reached_braking(ros, s
     ros.spin_for(0.3)
     # Reached braking within the deceleration limits, then never exceeded.
     assert_within_limits(driver.samples, LIMITS)
-    ramp = [s for s in driver.stamped_after(limited_at) if s.stamp < reached]
-    assert len(ramp) > 2, "the lower limit was not reached braking"
+    # Braked, not cut at once: from the last full-speed command to the first at the limit takes
+    # the braking time at the deceleration limit. Timed by stamps, not counted: cmd_vel keeps
+    # only the latest command, and on a loaded machine the driver missed most of the ramp's.
+    last_full = max(s.stamp for s in driver.samples if s.stamp < reached and moving(s.twist))
+    braking_time = (LINEAR_VEL - 0.1) / LIMITS.max_linear_decel
+    assert reached - last_full >= braking_time - 2.0 / RT_FREQ, (
+        f"the lower limit was not reached braking: {reached - last_full:.3f} s from full speed"
+    )
     assert all(
         abs(s.twist.vx) <= 0.1 and abs(s.twist.wz) <= 0.2 for s in driver.stamped_after(reached)
     )

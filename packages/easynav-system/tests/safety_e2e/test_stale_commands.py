@@ -208,8 +208,19 @@ def test_after_the_clock_jumps_back_cmd_timeout_counts_from_the_jump(ros, start_
     nodes = ["system_node", "controller_node", "localizer_node", "planner_node",
              "maps_manager_node", "sensors_node", "recovery_node"]  # fmt: skip
     rt, driver = start(ros, start_easynav, **{f"{n}.use_sim_time": True for n in nodes})
-    # This wait failed twice in about six full-suite runs, once on an idle machine (cause not
-    # found yet): the message says what each side saw, to find it next time.
+    # Simulated time starts for EasyNav with the first /clock it receives (the RT loop serves
+    # its subscription); until then no plugin runs. The wait for a full-speed command below
+    # failed twice in about six full-suite runs (once on an idle machine) without a single
+    # plugin having run (no cycle-time report at the stop): either /clock never reached
+    # EasyNav or its loops did not cycle. This wait tells which, and what was matched.
+    clock_subscription = rt.system_node.shared_clock.subscription
+    assert ros.spin_until(lambda: rt.system_node.now_seconds() >= 1000.0, timeout=10.0), (
+        f"EasyNav's nodes never received /clock: its subscription matched "
+        f"{clock_subscription.get_publisher_count()} publisher(s), the test's publisher "
+        f"{clock_publisher.get_subscription_count()} subscription(s); RT loop "
+        f"{rt.rt_loop.cycles} cycles (alive {rt.rt_loop.is_alive()}), non-RT loop "
+        f"{rt.nort_loop.cycles} cycles; node clocks: {node_clocks(rt)}"
+    )
     assert ros.spin_until(lambda: driver.last_is(moving), timeout=5.0), (
         f"no full-speed command within 5 s: {len(driver.samples)} received, the last "
         f"{driver.samples[-1] if driver.samples else None}; the controller's last command "
