@@ -77,6 +77,15 @@ def node_clocks(rt) -> str:
                      for node in nodes)
 
 
+def braking_time(driver, fault_time: float) -> float:
+    """From the last full-speed command to the first zero after ``fault_time`` (stamps): not
+    counted in commands, as cmd_vel keeps only the latest and a loaded machine's driver misses
+    some (a run saw only the final zero of a braking)."""
+    last_full = max(s.stamp for s in driver.samples if moving(s.twist))
+    first_zero = min(s.stamp for s in driver.stamped_after(fault_time) if s.twist.is_zero())
+    return first_zero - last_full
+
+
 def stopped_after(driver, t: float) -> bool:
     """The last command received is an exact zero computed after ``t`` (node clock)."""
     return bool(driver.samples) and driver.samples[-1].stamp > t and driver.last().is_zero()
@@ -98,7 +107,7 @@ def test_stale_or_invalid_commands_brake_to_zero_after_cmd_timeout_until_command
     last_valid = controller(rt).last_command.header.stamp
     braking = [s for s in driver.stamped_after(fault_time) if not moving(s.twist)]
     assert braking[0].stamp - last_valid >= CMD_TIMEOUT - 1e-6
-    assert braking[-1].stamp - braking[0].stamp >= BRAKING_TIME - 2 * CONTROLLER_PERIOD
+    assert braking_time(driver, fault_time) >= BRAKING_TIME - 2 * CONTROLLER_PERIOD
     assert_within_limits(driver.samples, LIMITS)  # also: no NaN ever reaches the robot
     status = diagnostic(rt, "cmd_vel")
     assert status.level == DiagnosticLevel.ERROR and status.hardware_id == "controller_node"
@@ -145,8 +154,7 @@ def test_throwing_controller_is_contained_the_robot_brakes_and_resumes(ros, star
     fault_time = wait_for_fault(ros, rt)
     assert ros.spin_until(lambda: stopped_after(driver, fault_time), timeout=3.0)
     # A failing controller stops the robot: braked within the deceleration limits, not dead.
-    braking = [s for s in driver.stamped_after(fault_time) if not moving(s.twist)]
-    assert braking[-1].stamp - braking[0].stamp >= BRAKING_TIME - 2 * CONTROLLER_PERIOD
+    assert braking_time(driver, fault_time) >= BRAKING_TIME - 2 * CONTROLLER_PERIOD
     assert_within_limits(driver.samples, LIMITS)
     status = diagnostic(rt, "ctrl.error")
     assert status.level == DiagnosticLevel.ERROR and status.hardware_id == "controller_node"
