@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
 
 import numpy as np
 import pytest
@@ -71,9 +72,11 @@ def ray_cast(costmap: Costmap2D, pose, beams: int, max_range: float, rng, noise=
 
 class Sim:
     """A unicycle on the twin-rooms costmap with drifting odometry, a 0.25 m high laser of
-    :data:`LASER_RANGE`, a clock; ``cls`` is the localizer under test."""
+    :data:`LASER_RANGE`, a clock; ``cls`` is the localizer under test. MH-AMCL's hypotheses
+    search runs in ``update`` (repeatable) unless ``background``."""
 
-    def __init__(self, cls, params: dict, start=(-5.5, 0.0, 0.0), seed=0) -> None:
+    def __init__(self, cls, params: dict, start=(-5.5, 0.0, 0.0), seed=0,
+                 background=False) -> None:
         self.rng = np.random.default_rng(seed)
         self.costmap = twin_rooms_costmap()
         self.t = 10.0
@@ -98,6 +101,7 @@ class Sim:
         p = self.loc.params
         pose = (p["initial_pose.x"], p["initial_pose.y"], p["initial_pose.yaw"])
         if isinstance(self.loc, MHAMCLLocalizer):
+            self.loc.search_in_background = background
             self.loc.rng = np.random.default_rng(seed + 100)
             self.loc.reset_pose(*pose, np.eye(2) * p["initial_pose.std_dev_xy"] ** 2,
                                 p["initial_pose.std_dev_yaw"] ** 2)
@@ -252,6 +256,75 @@ def test_a_kidnapped_robot_is_found_by_a_new_hypothesis(seed, caplog):
     errors = sim.drive(8.0)
     assert errors[-1] < 0.1 and np.mean(errors[-50:]) < 0.1, errors[::50]
     assert "new hypothesis" in caplog.text and "switched from hypothesis" in caplog.text
+
+
+def test_the_search_runs_beside_the_corrections_and_its_places_follow_the_odometry(caplog):
+    """In its own thread, a search does not hold up the corrections (here it is held while the
+    robot drives 1 s: five corrections meanwhile); its places, found in the scan it was
+    given, are moved by the odometry received since: the kidnapped robot is found where it
+    is when the search ends, 0.4 m further on."""
+    caplog.set_level("INFO", logger="easynav")
+    sim = Sim(MHAMCLLocalizer, {**MH, "initial_pose.x": -5.5}, seed=0, background=True)
+    loc = sim.loc
+    sim.drive(2.0)
+    if loc._search_future is not None:
+        loc._search_future.result(timeout=60.0)
+    assert sim.error() < 0.1
+    release, corrections = threading.Event(), []
+    search, correct = loc._search, loc._correct
+
+    def held_search(*args):
+        assert release.wait(timeout=60.0), "the test never released the search"
+        return search(*args)
+
+    def counted_correct(*args):
+        corrections.append(sim.t)
+        return correct(*args)
+
+    loc._search, loc._correct = held_search, counted_correct
+    sim.true[:] = (-0.5, 0.0, 0.0)  # kidnapped into the corridor
+    for _ in range(40):  # until the next search (every 3 s) starts on a kidnapped scan
+        sim.drive(0.2)
+        if loc._search_future is not None:
+            break
+    running = loc._search_future
+    assert running is not None and not running.done()
+    before, scanned_at = len(corrections), sim.true.copy()
+    sim.drive(1.0)
+    assert len(corrections) - before == 5 and not running.done()
+    release.set()
+    running.result(timeout=60.0)
+    sim.drive(0.2)  # takes the candidates
+    assert loc._search_future is None or loc._search_future is not running
+    moved = [h.estimate() for h in loc.hypotheses if _near(h.estimate(), sim.true, 0.15)]
+    assert moved, ([h.estimate() for h in loc.hypotheses], sim.true)
+    assert math.hypot(*(sim.true[:2] - scanned_at[:2])) > 0.35
+    errors = sim.drive(5.0)
+    assert errors[-1] < 0.1, errors[::50]
+    assert "switched from hypothesis" in caplog.text
+
+
+def test_a_pose_given_during_a_search_is_not_overridden_by_it():
+    """``initialpose`` while a global localisation's search runs: its places are dropped."""
+    sim = Sim(MHAMCLLocalizer, MH, seed=2, background=True)
+    loc = sim.loc
+    release = threading.Event()
+    search = loc._search
+
+    def held_search(*args):
+        assert release.wait(timeout=60.0)
+        return search(*args)
+
+    loc._search = held_search
+    sim.nav_state.set("localizer.reinitialize_global_localization", True)
+    sim.drive(0.2)
+    running = loc._search_future
+    assert running is not None
+    loc.reset_pose(-5.5, 0.0, 0.0, np.eye(2) * 0.01, 0.01)
+    release.set()
+    running.result(timeout=60.0)
+    sim.drive(1.0)
+    assert len(loc.hypotheses) == 1 and sim.error() < 0.1
 
 
 def _tracking_sim(**params) -> Sim:

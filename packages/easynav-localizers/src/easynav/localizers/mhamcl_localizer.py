@@ -4,6 +4,7 @@ Costmap2D."""
 from __future__ import annotations
 
 import math
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import cv2
@@ -103,7 +104,12 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
       best's log-likelihood plus ``log(new_hypothesis_ratio · q_candidate / q_best)``: a
       newcomer must explain the scans better for a while before it wins. A global localisation
       discards the hypotheses and starts one per cluster (at most ``max_hypotheses``, all even).
-      The candidates are moved by the odometry received during the search.
+      The search runs in a thread of its own, as the original's map matching does: on a
+      large map it takes seconds (the playground's campus: ~3 s), and run inside ``update``
+      it left the hypotheses without a correction for as long (1.6 corrections per second
+      instead of 5). ``update`` starts a search when one is due and
+      none is running, and takes its candidates at the first update after it ends, moved by
+      the odometry received since its scan.
     - Merge: two hypotheses within ``hypo_merge_distance`` and ``hypo_merge_angle`` become the
       more likely one. Prune: a hypothesis whose likelihood ratio to the best falls below
       ``hypo_prune_ratio``, whose quality falls below ``very_low_q_hypo_threshold``, or whose
@@ -117,8 +123,9 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
 
     ``multihypothesis`` false: one hypothesis, no creation (a plain AMCL with the original's
     reseed). NavState: as the costmap AMCL; also writes ``localizer.mhamcl.hypotheses``.
-    Thread contract: as :class:`CostmapAMCLLocalizer` (the search runs in ``update``, outside the
-    lock). Exceptions: configure fails naming a bad parameter.
+    Thread contract: as :class:`CostmapAMCLLocalizer`; the search runs in its own thread
+    (``search_in_background``, the default; False: in ``update`` itself, repeatable for tests)
+    on copies of what it reads. Exceptions: configure fails naming a bad parameter.
     """
 
     PARAMETERS = _replace(
@@ -200,11 +207,30 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
         self._next_ident = 0
         self._rng = np.random.default_rng()
         self._last_search = 0.0
+        #: The hypotheses search runs in a thread of its own (False: in ``update``, which then
+        #: waits for it; repeatable, for tests that seed the generator).
+        self.search_in_background = True
+        self._search_executor: ThreadPoolExecutor | None = None
+        # The search running: its future, whether it is a global localisation, the odometry
+        # of its scan.
+        self._search_future: Future | None = None
+        self._search_global = False
+        self._search_odom = None
+        self._search_epoch = 0  # a pose reset discards the search running (its epoch is older)
+        self._search_started_epoch = 0
         self._mh_fields_key: tuple | None = None
         self._weight_field: np.ndarray | None = None
         self._quality_field: np.ndarray | None = None
 
     # -- configuration ------------------------------------------------------------------------
+    def on_cleanup(self) -> None:
+        """Stop the search thread (a search running is abandoned), then the base class's."""
+        executor, self._search_executor = self._search_executor, None
+        self._search_future = None
+        if executor is not None:
+            executor.shutdown(wait=False, cancel_futures=True)
+        super().on_cleanup()
+
     def on_initialize(self) -> None:
         p = self.params
         alias = self.plugin_name
@@ -268,6 +294,9 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
             h.filter.seed(x, y, yaw, cov_xy, math.sqrt(max(var_yaw, 0.0)),
                           self.min_noise_xy, self.min_noise_yaw)
             self._select(h)
+        # A search running started before: its places (a global one's above all) must not
+        # override the pose given now.
+        self._search_epoch += 1
         self._last_reseed = self._last_search = self.now()
         self.logger.info(f"{self.plugin_name}: hypotheses reset to one around "
                          f"({x:.3f}, {y:.3f}, {yaw:.3f})")
@@ -304,12 +333,8 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
             likelihoods, _ = hit_fractions(poses, points, base, weight_field)
         qualities = self._qualities(base, poses, points, quality_field)
         now = self.now()
-        global_now, self._global_requested = self._global_requested, False
-        search = global_now or (p.multihypothesis and (
-            now - self._last_search >= 1.0 / p.hypotheses_freq or now < self._last_search))
-        candidates = self._search(base, points) if search else None
-        if search:
-            self._last_search = now
+        candidates, global_now, odom_at_search = self._search_step(
+            base, points, quality_field, now, odom_at_scan)
         reseed_due = now - self._last_reseed >= self.reseed_period or now < self._last_reseed
         with self._lock:
             if generation == self._generation and hypotheses == self.hypotheses:
@@ -319,7 +344,7 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
                         self._reseed_hypothesis(h)
                     self._last_reseed = now
                 if candidates is not None:
-                    candidates = self._moved(candidates, odom_at_scan)
+                    candidates = self._moved(candidates, odom_at_search)
                     if global_now:
                         self._restart_from(candidates)
                     else:
@@ -453,23 +478,56 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
         cloud.weights /= cloud.weights.sum()
 
     # -- hypotheses management ----------------------------------------------------------------
-    def _search(self, base: Costmap2D, points: np.ndarray) -> list[tuple[np.ndarray, float]]:
+    def _search_step(self, base: Costmap2D, points: np.ndarray, quality_field: np.ndarray,
+                     now: float, odom_at_scan):
+        """Start a hypotheses search when one is due and none runs; return the candidates of
+        the search that ended, if any: ``(candidates or None, global localisation?, odometry
+        of its scan)``. Non-RT thread, outside the lock."""
+        p = self.params
+        candidates, global_search, odom_at_search = None, False, None
+        future = self._search_future
+        if future is not None and future.done():
+            self._search_future = None
+            if self._search_started_epoch == self._search_epoch:
+                candidates, global_search, odom_at_search = (
+                    future.result(), self._search_global, self._search_odom)
+        due = self._global_requested or (p.multihypothesis and (
+            now - self._last_search >= 1.0 / p.hypotheses_freq or now < self._last_search))
+        if due and self._search_future is None:
+            global_now, self._global_requested = self._global_requested, False
+            self._last_search = now
+            if self.search_in_background:
+                if self._search_executor is None:
+                    self._search_executor = ThreadPoolExecutor(
+                        max_workers=1, thread_name_prefix=f"{self.plugin_name}_search")
+                # Its own generator: numpy's are not for two threads at once.
+                rng = np.random.default_rng(self._rng.integers(2**63))
+                self._search_future = self._search_executor.submit(
+                    self._search, base, points, quality_field, rng)
+                self._search_global, self._search_odom = global_now, odom_at_scan
+                self._search_started_epoch = self._search_epoch
+            elif candidates is None:
+                candidates = self._search(base, points, quality_field, self._rng)
+                global_search, odom_at_search = global_now, odom_at_scan
+        return candidates, global_search, odom_at_search
+
+    def _search(self, base: Costmap2D, points: np.ndarray, quality_field: np.ndarray,
+                rng: np.random.Generator) -> list[tuple[np.ndarray, float]]:
         """Clusters of the poses where the scan fits the map, best first: ``(pose, quality)``
-        of each cluster's best pose, quality at least ``min_candidate_weight``. Outside the
-        lock (the compiled scoring releases the GIL)."""
+        of each cluster's best pose, quality at least ``min_candidate_weight``. The search
+        thread (or ``update``'s), outside the lock; the compiled scoring releases the GIL."""
         p = self.params
         if base is not self._reset_map:
             self._reset_fields = (likelihood_field(base, RESET_STRIDE),
                                   likelihood_field(base, RESET_FINE_SIGMA))
             self._reset_map = base
         try:
-            cloud = sensor_reset_poses(base, points, RESET_REFINED, self._rng,
+            cloud = sensor_reset_poses(base, points, RESET_REFINED, rng,
                                        *self._reset_fields, spread=(0.0, 0.0))
         except ValueError as exc:
             self._throttle.warn(self.logger, "no-search",
                                 f"{self.plugin_name}: no hypotheses search: {exc}")
             return []
-        _, quality_field = self._fields(base)
         qualities = self._qualities(base, cloud, points, quality_field)
         return cluster_poses(cloud, qualities, p.min_candidate_distance,
                              p.min_candidate_angle, p.min_candidate_weight)
