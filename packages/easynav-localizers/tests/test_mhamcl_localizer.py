@@ -405,6 +405,27 @@ def test_costmap_amcl_parameters_load_unchanged():
     assert max(errors) < 0.15
 
 
+def test_on_a_coarse_map_the_true_pose_scores_full_quality():
+    """A wall on a 0.2 m map (coarser than 3σ = 0.15 m): a scan measured on its surface,
+    with 2 cm noise, lands partly in the free cells beside it. The quality counts a point
+    within one cell of the wall: the true pose scores 1, a pose 0.5 m off 0; counting only
+    within 3σ it scored about half at the true pose (the grid's error taken for a misfit)."""
+    resolution = 0.2
+    data = np.zeros((50, 50), dtype=np.uint8)  # 10 x 10 m from (0, 0)
+    data[:, 25] = 254  # a wall: x in [5.0, 5.2)
+    coarse = Costmap2D(data, resolution, 0.0, 0.0, "map", 1.0)
+    sim = _tracking_sim()
+    _, quality_field = sim.loc._fields(coarse)
+    rng = np.random.default_rng(0)
+    ys = np.linspace(-3.0, 3.0, 61)
+    points = np.column_stack((3.0 + rng.normal(0.0, 0.02, len(ys)), ys))  # from (2, 5, 0)
+    poses = np.array([[2.0, 5.0, 0.0], [1.5, 5.0, 0.0]])
+    quality = MHAMCLLocalizer._qualities(coarse, poses, points, quality_field)
+    assert quality[0] == 1.0 and quality[1] == 0.0
+    within_3_sigma = (np.asarray(quality_field) > 0).sum(axis=1)
+    assert within_3_sigma[0] == 3  # the wall's cell and one free cell on each side
+
+
 def test_cluster_poses_keeps_the_best_of_each_place():
     poses = np.array([(0.0, 0.0, 0.0), (0.2, 0.0, 0.1), (5.0, 0.0, 0.0), (0.1, 0.0, math.pi),
                       (9.0, 0.0, 0.0)])
