@@ -258,73 +258,153 @@ def test_a_kidnapped_robot_is_found_by_a_new_hypothesis(seed, caplog):
     assert "new hypothesis" in caplog.text and "switched from hypothesis" in caplog.text
 
 
+class HeldSearch:
+    """Wraps a localizer's search so that each one waits for :meth:`finish` (the test decides
+    when it ends, and when the next one may run); :meth:`close` releases it and stops the
+    search thread."""
+
+    def __init__(self, loc, raises: Exception | None = None) -> None:
+        self.loc, self.raises = loc, raises
+        self.released = threading.Event()
+        self.started = 0
+        search = loc._search
+
+        def held(*args):
+            self.started += 1
+            assert self.released.wait(timeout=60.0), "the test never released the search"
+            if self.raises is not None:
+                raise self.raises
+            return search(*args)
+
+        loc._search = held
+
+    def finish(self) -> None:
+        """Let the running search end and wait for it; the next one runs freely."""
+        future = self.loc._search_future
+        assert future is not None, "no search is running"
+        self.released.set()
+        future.exception(timeout=60.0)
+
+    def hold_next(self) -> None:
+        self.released.clear()
+
+    def close(self) -> None:
+        self.released.set()
+        self.loc.on_cleanup()
+
+
+def _background_sim(params: dict, seed: int) -> Sim:
+    return Sim(MHAMCLLocalizer, params, seed=seed, background=True)
+
+
 def test_the_search_runs_beside_the_corrections_and_its_places_follow_the_odometry(caplog):
     """In its own thread, a search does not hold up the corrections (here it is held while the
     robot drives 1 s: five corrections meanwhile); its places, found in the scan it was
     given, are moved by the odometry received since: the kidnapped robot is found where it
     is when the search ends, 0.4 m further on."""
     caplog.set_level("INFO", logger="easynav")
-    sim = Sim(MHAMCLLocalizer, {**MH, "initial_pose.x": -5.5}, seed=0, background=True)
+    sim = _background_sim({**MH, "initial_pose.x": -5.5}, seed=0)
     loc = sim.loc
-    sim.drive(2.0)
-    if loc._search_future is not None:
-        loc._search_future.result(timeout=60.0)
-    assert sim.error() < 0.1
-    release, corrections = threading.Event(), []
-    search, correct = loc._search, loc._correct
-
-    def held_search(*args):
-        assert release.wait(timeout=60.0), "the test never released the search"
-        return search(*args)
+    sim.drive(2.0)  # no search yet (every 3 s)
+    assert sim.error() < 0.1 and loc._search_future is None
+    held, corrections = HeldSearch(loc), []
+    correct = loc._correct
 
     def counted_correct(*args):
         corrections.append(sim.t)
         return correct(*args)
 
-    loc._search, loc._correct = held_search, counted_correct
-    sim.true[:] = (-0.5, 0.0, 0.0)  # kidnapped into the corridor
-    for _ in range(40):  # until the next search (every 3 s) starts on a kidnapped scan
-        sim.drive(0.2)
-        if loc._search_future is not None:
-            break
-    running = loc._search_future
-    assert running is not None and not running.done()
-    before, scanned_at = len(corrections), sim.true.copy()
-    sim.drive(1.0)
-    assert len(corrections) - before == 5 and not running.done()
-    release.set()
-    running.result(timeout=60.0)
-    sim.drive(0.2)  # takes the candidates
-    assert loc._search_future is None or loc._search_future is not running
-    moved = [h.estimate() for h in loc.hypotheses if _near(h.estimate(), sim.true, 0.15)]
-    assert moved, ([h.estimate() for h in loc.hypotheses], sim.true)
-    assert math.hypot(*(sim.true[:2] - scanned_at[:2])) > 0.35
-    errors = sim.drive(5.0)
-    assert errors[-1] < 0.1, errors[::50]
-    assert "switched from hypothesis" in caplog.text
+    loc._correct = counted_correct
+    try:
+        sim.true[:] = (-0.5, 0.0, 0.0)  # kidnapped into the corridor
+        for _ in range(40):  # until the next search starts, on a kidnapped scan
+            sim.drive(0.2)
+            if loc._search_future is not None:
+                break
+        running = loc._search_future
+        assert running is not None
+        before, scanned_at = len(corrections), sim.true.copy()
+        sim.drive(1.0)
+        assert len(corrections) - before == 5 and not running.done()
+        loc.search_in_background = False  # from here on repeatable: the searches in update
+        held.finish()
+        sim.drive(0.2)  # takes the candidates
+        assert loc._search_future is None and held.started == 1
+        found = [h.estimate() for h in loc.hypotheses if _near(h.estimate(), sim.true, 0.15)]
+        assert found, ([h.estimate() for h in loc.hypotheses], sim.true)
+        assert math.hypot(*(sim.true[:2] - scanned_at[:2])) > 0.35  # where it is, not was
+        errors = sim.drive(5.0)
+        assert errors[-1] < 0.1, errors[::50]
+        assert "switched from hypothesis" in caplog.text
+    finally:
+        held.close()
 
 
-def test_a_pose_given_during_a_search_is_not_overridden_by_it():
-    """``initialpose`` while a global localisation's search runs: its places are dropped."""
-    sim = Sim(MHAMCLLocalizer, MH, seed=2, background=True)
+def test_a_global_localisation_asked_during_a_search_runs_after_it(caplog):
+    caplog.set_level("INFO", logger="easynav")
+    sim = _background_sim({**MH, "hypotheses_freq": 5.0}, seed=2)
     loc = sim.loc
-    release = threading.Event()
-    search = loc._search
+    held = HeldSearch(loc)
+    try:
+        sim.drive(0.4)  # a periodic search starts (due 0.2 s after the start) and is held
+        assert loc._search_future is not None and not loc._search_global
+        sim.nav_state.set("localizer.reinitialize_global_localization", True)
+        sim.drive(0.4)  # the request waits
+        assert not loc._search_global and "global localisation:" not in caplog.text
+        held.finish()
+        held.hold_next()
+        sim.drive(0.2)  # the periodic search's places taken, the global search started
+        assert loc._search_future is not None and loc._search_global
+        held.finish()
+        sim.drive(0.2)
+        assert held.started == 2
+        assert "global localisation:" in caplog.text and len(loc.hypotheses) >= 2
+    finally:
+        held.close()
 
-    def held_search(*args):
-        assert release.wait(timeout=60.0)
-        return search(*args)
 
-    loc._search = held_search
-    sim.nav_state.set("localizer.reinitialize_global_localization", True)
-    sim.drive(0.2)
-    running = loc._search_future
-    assert running is not None
-    loc.reset_pose(-5.5, 0.0, 0.0, np.eye(2) * 0.01, 0.01)
-    release.set()
-    running.result(timeout=60.0)
-    sim.drive(1.0)
-    assert len(loc.hypotheses) == 1 and sim.error() < 0.1
+@pytest.mark.parametrize("asked", ["while its search runs", "while it waits for a search"])
+def test_a_pose_given_meanwhile_wins_over_a_global_localisation(asked, caplog):
+    """``initialpose`` while a global localisation's search runs, or while the request waits
+    for a periodic search to end: the pose given stays, the global localisation never
+    happens."""
+    caplog.set_level("INFO", logger="easynav")
+    sim = _background_sim({**MH, "hypotheses_freq": 5.0}, seed=2)
+    loc = sim.loc
+    held = HeldSearch(loc)
+    try:
+        if asked == "while its search runs":
+            sim.nav_state.set("localizer.reinitialize_global_localization", True)
+            sim.drive(0.2)
+            assert loc._search_future is not None and loc._search_global
+        else:
+            sim.drive(0.4)
+            assert loc._search_future is not None and not loc._search_global
+            sim.nav_state.set("localizer.reinitialize_global_localization", True)
+            sim.drive(0.2)
+        loc.reset_pose(*sim.true, np.eye(2) * 0.01, 0.01)  # where the robot is
+        loc.search_in_background = False  # from here on repeatable: the searches in update
+        held.finish()
+        sim.drive(1.0)
+        assert "global localisation:" not in caplog.text
+        assert sim.error() < 0.1
+    finally:
+        held.close()
+
+
+def test_a_search_that_fails_is_a_warning_and_the_corrections_go_on(caplog):
+    caplog.set_level("INFO", logger="easynav")
+    sim = _background_sim({**MH, "initial_pose.x": -5.5, "hypotheses_freq": 5.0}, seed=3)
+    held = HeldSearch(sim.loc, raises=RuntimeError("matcher out of memory"))
+    try:
+        sim.drive(0.4)
+        held.finish()
+        errors = sim.drive(2.0)
+        assert ("hypotheses search failed, no new hypotheses: RuntimeError: matcher out of "
+                "memory") in caplog.text
+        assert max(errors) < 0.1
+    finally:
+        held.close()
 
 
 def _tracking_sim(**params) -> Sim:
@@ -422,8 +502,8 @@ def test_on_a_coarse_map_the_true_pose_scores_full_quality():
     poses = np.array([[2.0, 5.0, 0.0], [1.5, 5.0, 0.0]])
     quality = MHAMCLLocalizer._qualities(coarse, poses, points, quality_field)
     assert quality[0] == 1.0 and quality[1] == 0.0
-    within_3_sigma = (np.asarray(quality_field) > 0).sum(axis=1)
-    assert within_3_sigma[0] == 3  # the wall's cell and one free cell on each side
+    counted = (np.asarray(quality_field) > 0).sum(axis=1)
+    assert counted[0] == 3  # the wall's cell and one free cell on each side
 
 
 def test_cluster_poses_keeps_the_best_of_each_place():

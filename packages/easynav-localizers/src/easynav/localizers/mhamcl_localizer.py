@@ -124,9 +124,12 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
 
     ``multihypothesis`` false: one hypothesis, no creation (a plain AMCL with the original's
     reseed). NavState: as the costmap AMCL; also writes ``localizer.mhamcl.hypotheses``.
-    Thread contract: as :class:`CostmapAMCLLocalizer`; the search runs in its own thread
-    (``search_in_background``, the default; False: in ``update`` itself, repeatable for tests)
-    on copies of what it reads. Exceptions: configure fails naming a bad parameter.
+    Thread contract: as :class:`CostmapAMCLLocalizer`; the search runs in a thread of its own
+    (attribute ``search_in_background``, True; False: in ``update`` itself, repeatable, for
+    tests), reading the map (replaced, never changed in place), the scan's points and the
+    parameters, and its own caches; one search at a time. A search running at cleanup or at
+    exit ends on its own (a few seconds on a large map). Exceptions: configure fails naming a
+    bad parameter; a failed search is a warning, the correction goes on.
     """
 
     PARAMETERS = _replace(
@@ -233,6 +236,11 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
             executor.shutdown(wait=False, cancel_futures=True)
         super().on_cleanup()
 
+    def on_deactivate(self) -> None:
+        """A search running is dropped: its scan is from before the pause."""
+        self._search_epoch += 1
+        super().on_deactivate()
+
     def on_initialize(self) -> None:
         p = self.params
         alias = self.plugin_name
@@ -296,9 +304,10 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
             h.filter.seed(x, y, yaw, cov_xy, math.sqrt(max(var_yaw, 0.0)),
                           self.min_noise_xy, self.min_noise_yaw)
             self._select(h)
-        # A search running started before: its places (a global one's above all) must not
-        # override the pose given now.
-        self._search_epoch += 1
+            # The pose given now wins over a search running (a global one's above all) and a
+            # global localisation requested before and still waiting for its search.
+            self._search_epoch += 1
+            self._global_requested = False
         self._last_reseed = self._last_search = self.now()
         self.logger.info(f"{self.plugin_name}: hypotheses reset to one around "
                          f"({x:.3f}, {y:.3f}, {yaw:.3f})")
@@ -327,6 +336,7 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
             snapshot = [h.filter.poses.copy() for h in hypotheses]
             generation = self._generation
             odom_at_scan = self._odom_used
+            epoch = self._search_epoch
         sizes = [len(s) for s in snapshot]
         poses = np.concatenate(snapshot)
         if p.sensor_model == LIKELIHOOD_FIELD:
@@ -336,7 +346,7 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
         qualities = self._qualities(base, poses, points, quality_field)
         now = self.now()
         candidates, global_now, odom_at_search = self._search_step(
-            base, points, quality_field, now, odom_at_scan)
+            base, points, quality_field, now, odom_at_scan, epoch)
         reseed_due = now - self._last_reseed >= self.reseed_period or now < self._last_reseed
         with self._lock:
             if generation == self._generation and hypotheses == self.hypotheses:
@@ -391,9 +401,9 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
         return points[:, :2]
 
     def _fields(self, base: Costmap2D) -> tuple[np.ndarray, np.ndarray]:
-        """The soft hit field (σ ``distance_perception_error``, zero beyond 3σ) and the
-        quality field (1 within 3σ of a lethal surface cell, :func:`surface_cells`, or
-        within one cell on a coarser map), cached per map object and σ."""
+        """The soft hit field (σ ``distance_perception_error``, at least a third of a cell;
+        zero beyond 3σ) and the quality field (1 within 3σ of a lethal surface cell,
+        :func:`surface_cells`), cached per map object and σ."""
         sigma = float(self.params.distance_perception_error)
         key = (base, sigma)  # map.base is replaced, never mutated: cache per object
         if (self._mh_fields_key is None or self._mh_fields_key[0] is not base
@@ -405,15 +415,16 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
                 d = d * base.resolution
             else:
                 d = np.full(obstacles.shape, np.inf, dtype=np.float32)
-            near = d <= 3.0 * sigma
+            # At least a third of a cell: on a map coarser than 3σ, a point measured on an
+            # obstacle's surface falls in the free cell beside it about half the time (the
+            # grid's error, not the sensor's), and counted as a miss it ranked look-alike
+            # places above the true one (the campus' 0.2 m map: quality 0.55-0.63 at the true
+            # pose, 0.86-0.94 along another fence, which took over after 20 s).
+            sigma = max(sigma, base.resolution / 3.0)
+            near = d <= 3.0 * sigma * (1.0 + 1e-6)  # one cell away counts, float32 or not
             self._weight_field = np.where(near, np.exp(-0.5 * np.square(d / sigma)),
                                           0.0).astype(np.float32)
-            # The quality's tolerance is at least one cell: on a map coarser than 3σ, a point
-            # measured on an obstacle's surface falls in the free cell beside it about half
-            # the time (the grid's error, not the sensor's), and the share of hits then ranked
-            # look-alike places above the true one (the campus' 0.2 m map: the true pose
-            # 0.55-0.63, a place along another fence 0.86-0.94, taken over after 20 s).
-            self._quality_field = (d <= max(3.0 * sigma, base.resolution)).astype(np.float32)
+            self._quality_field = near.astype(np.float32)
             self._mh_fields_key = key
         return self._weight_field, self._quality_field
 
@@ -487,10 +498,11 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
 
     # -- hypotheses management ----------------------------------------------------------------
     def _search_step(self, base: Costmap2D, points: np.ndarray, quality_field: np.ndarray,
-                     now: float, odom_at_scan):
+                     now: float, odom_at_scan, epoch: int):
         """Start a hypotheses search when one is due and none runs; return the candidates of
         the search that ended, if any: ``(candidates or None, global localisation?, odometry
-        of its scan)``. Non-RT thread, outside the lock."""
+        of its scan)``. ``epoch``: the search epoch when the scan was taken. Non-RT thread,
+        outside the lock."""
         p = self.params
         candidates, global_search, odom_at_search = None, False, None
         future = self._search_future
@@ -498,7 +510,7 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
             self._search_future = None
             if self._search_started_epoch == self._search_epoch:
                 candidates, global_search, odom_at_search = (
-                    future.result(), self._search_global, self._search_odom)
+                    self._search_result(future), self._search_global, self._search_odom)
         due = self._global_requested or (p.multihypothesis and (
             now - self._last_search >= 1.0 / p.hypotheses_freq or now < self._last_search))
         if due and self._search_future is None:
@@ -513,11 +525,23 @@ class MHAMCLLocalizer(CostmapAMCLLocalizer):
                 self._search_future = self._search_executor.submit(
                     self._search, base, points, quality_field, rng)
                 self._search_global, self._search_odom = global_now, odom_at_scan
-                self._search_started_epoch = self._search_epoch
+                self._search_started_epoch = epoch
             elif candidates is None:
                 candidates = self._search(base, points, quality_field, self._rng)
                 global_search, odom_at_search = global_now, odom_at_scan
         return candidates, global_search, odom_at_search
+
+    def _search_result(self, future: Future):
+        """The candidates of a search that ended; None (and a warning) when it raised: the
+        correction goes on without them."""
+        try:
+            return future.result()
+        except Exception as exc:
+            kind = "global localisation" if self._search_global else "hypotheses search"
+            self._throttle.warn(self.logger, "search-failed",
+                                f"{self.plugin_name}: {kind} failed, no new hypotheses: "
+                                f"{type(exc).__name__}: {exc}")
+            return None
 
     def _search(self, base: Costmap2D, points: np.ndarray, quality_field: np.ndarray,
                 rng: np.random.Generator) -> list[tuple[np.ndarray, float]]:
