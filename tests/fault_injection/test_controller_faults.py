@@ -101,13 +101,14 @@ def test_stale_or_invalid_commands_are_braked_to_zero_after_cmd_timeout(ros, sta
     assert all(tw.is_finite() for _, tw in recorder.samples)  # no NaN reaches the robot
     assert_within_limits(recorder.samples, LIMITS)
     # The robot keeps its last valid command until cmd_timeout after it, then brakes.
-    # The last valid command came at most one controller period before the fault. Bounded by
-    # the first braking command received and the last full-speed one: cmd_vel keeps only the
-    # latest command, and on a loaded machine some never reach the robot.
+    # The last valid command came at most one controller period before the fault. cmd_vel
+    # keeps only the latest command, and on a loaded machine the first braking commands may
+    # never reach the robot: the first received is at the latest the final zero, a braking
+    # time after the braking began.
     braking = [t for t, tw in recorder.between(fault_time) if not full_speed(tw)]
-    last_full = max(t for t, tw in recorder.samples if full_speed(tw))
-    assert braking[0] - fault_time >= CMD_TIMEOUT - 0.03
-    assert last_full - fault_time <= CMD_TIMEOUT + 0.1
+    braking_time = max(LINEAR_VEL / LIMITS.max_linear_decel,
+                       ANGULAR_VEL / LIMITS.max_angular_decel)
+    assert CMD_TIMEOUT - 0.03 <= braking[0] - fault_time <= CMD_TIMEOUT + 0.1 + braking_time
     status = diagnostic(rt, "cmd_vel")
     assert status.level == DiagnosticLevel.ERROR and status.hardware_id == "controller_node"
     assert status.values.get("timeout") == "true"

@@ -183,6 +183,32 @@ class RobotDriver:
         return [s for s in self.samples if s.stamp >= stamp]
 
 
+class PublishedCommands:
+    """Every command a running EasyNav (in this process) publishes on its velocity topic, with
+    its stamp, recorded as it is published: what was sent, none missed.
+
+    The driver's record is what arrived, and the publisher keeps only the latest command
+    (depth 1): on a loaded machine the driver misses some, a braking ramp's among them. The
+    shape of a ramp is checked here; what the robot ends up doing, on the driver's side.
+    Commands are published when they change (and every keepalive period, when set).
+    """
+
+    def __init__(self, rt) -> None:
+        node = rt.system_node.controller_node
+        self.samples: list[Sample] = []
+        publish = node.publish_twist
+
+        def recorded(twist: Twist, now: float) -> None:  # the RT thread
+            self.samples.append(Sample(now, time.monotonic(), Twist(*twist.as_tuple())))
+            publish(twist, now)
+
+        node.publish_twist = recorded
+
+    def stamped_after(self, stamp: float) -> list[Sample]:
+        """Commands stamped at or after ``stamp`` (node clock)."""
+        return [s for s in list(self.samples) if s.stamp >= stamp]
+
+
 class SafetyPlc:
     """The certified safety channel's bridge: publishes ``easynav_interfaces/SafetyStatus`` on
     ``easynav_safety_status`` every ``period`` seconds while :attr:`publishing`.

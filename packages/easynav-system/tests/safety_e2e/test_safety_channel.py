@@ -10,6 +10,7 @@ import time
 
 import pytest
 from safety_e2e_harness import (
+    PublishedCommands,
     RobotDriver,
     SafetyPlc,
     assert_ramps_up_from_zero,
@@ -18,14 +19,7 @@ from safety_e2e_harness import (
     full_speed,
     requires_sched_fifo,
 )
-from safety_e2e_params import (
-    ANGULAR_VEL,
-    LIMITS,
-    LINEAR_VEL,
-    RT_FREQ,
-    safety_mode_system,
-    system,
-)
+from safety_e2e_params import ANGULAR_VEL, LIMITS, LINEAR_VEL, safety_mode_system, system
 
 from easynav.core.types import DiagnosticLevel, Header, Pose, PoseStamped, Twist
 from easynav.system.goals.goal_client_state import GoalClientState
@@ -163,6 +157,8 @@ def test_safely_limited_speed_cuts_the_limits_down_and_is_reached_braking(ros, s
     controller_node = rt.system_node.controller_node
     controller = controller_node.plugins[0].plugin
 
+    published = PublishedCommands(rt)
+    limited_at = time.time()
     plc.limit_speed(0.1, 0.2, active_field="warning_field")
 
     def at_limit(twist) -> bool:
@@ -173,14 +169,11 @@ def test_safely_limited_speed_cuts_the_limits_down_and_is_reached_braking(ros, s
     ros.spin_for(0.3)
     # Reached braking within the deceleration limits, then never exceeded.
     assert_within_limits(driver.samples, LIMITS)
-    # Braked, not cut at once: from the last full-speed command to the first at the limit takes
-    # the braking time at the deceleration limit. Timed by stamps, not counted: cmd_vel keeps
-    # only the latest command, and on a loaded machine the driver missed most of the ramp's.
-    last_full = max(s.stamp for s in driver.samples if s.stamp < reached and moving(s.twist))
-    braking_time = (LINEAR_VEL - 0.1) / LIMITS.max_linear_decel
-    assert reached - last_full >= braking_time - 2.0 / RT_FREQ, (
-        f"the lower limit was not reached braking: {reached - last_full:.3f} s from full speed"
-    )
+    # Reached braking, not cut at once: the ramp as published (the driver received only 2 of
+    # its commands in a run on a loaded machine: the publisher keeps only the latest).
+    ramp = [s for s in published.stamped_after(limited_at) if s.stamp < reached]
+    assert len(ramp) > 2, f"the lower limit was not reached braking: {ramp}"
+    assert_within_limits(published.samples, LIMITS)
     assert all(
         abs(s.twist.vx) <= 0.1 and abs(s.twist.wz) <= 0.2 for s in driver.stamped_after(reached)
     )
