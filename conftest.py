@@ -4,9 +4,13 @@ Where the runtime (easynav-system) is not installed (the kernel or a plugin dist
 alone, without ROS), there is no ROS to isolate and no ROS fixture to offer.
 """
 
+import gc
 import importlib.util
 import os
+import sys
 import tempfile
+import threading
+import time
 
 if importlib.util.find_spec("easynav.system") is not None:
     from easynav.system.testing.dds_isolation import isolate_dds
@@ -66,3 +70,35 @@ def pytest_terminal_summary(terminalreporter, config) -> None:
         f"(these tests {100 * min(own, busy) / total:.0f}%, other processes "
         f"{100 * others / total:.0f}%), {100 * steal / total:.0f}% stolen by the hypervisor"
     )
+
+
+# Long garbage collections, in the output of the test they happened in: a collection holds the
+# GIL, and the finalizers it runs (an earlier test's ROS objects among them) run in whichever
+# thread triggered it, an EasyNav loop's too. A test whose loops stood still says so here.
+_GC_REPORTED_AFTER = 0.2  # s
+_gc_started: dict[int, float] = {}
+
+
+def _time_garbage_collection(phase: str, info: dict) -> None:
+    thread = threading.get_ident()
+    if phase == "start":
+        _gc_started[thread] = time.perf_counter()
+        return
+    started = _gc_started.pop(thread, None)
+    if started is None:
+        return
+    took = time.perf_counter() - started
+    if took >= _GC_REPORTED_AFTER:
+        sys.stderr.write(
+            f"[conftest] a garbage collection (generation {info.get('generation')}, "
+            f"{info.get('collected')} objects) took {took:.2f} s in thread "
+            f"{threading.current_thread().name}\n"
+        )
+
+
+def _install_garbage_collection_timer() -> None:
+    if _time_garbage_collection not in gc.callbacks:
+        gc.callbacks.append(_time_garbage_collection)
+
+
+_install_garbage_collection_timer()
