@@ -1,5 +1,5 @@
 """FactorGraphEstimator (GTSAM fixed-lag smoothing) without ROS: tracking with GNSS noise, a
-GNSS outage, GNSS jumps."""
+GNSS outage, GNSS jumps, GNSS fixes late against the odometry, a failing solver."""
 
 from __future__ import annotations
 
@@ -19,8 +19,12 @@ OUTAGE = (60.0, 90.0)
 JUMP = (120.0, 122.0)
 
 
-def simulate(duration=150.0, outage=OUTAGE, jump=JUMP, robust="cauchy", seed=0):
+def simulate(duration=150.0, outage=OUTAGE, jump=JUMP, robust="cauchy", seed=0,
+             max_delay=0.0):
+    """A robot on a weaving course; ``max_delay``: each fix reaches the estimator up to that
+    many seconds after its stamp (uniform), after the odometry of that time."""
     rng = np.random.default_rng(seed)
+    in_flight = []  # (arrival, stamp, x, y) of the fixes not yet delivered
     est = FactorGraphEstimator(lag=5.0, keyframe_period=0.2, robust=robust)
     true = np.array((0.0, 0.0, 0.3))
     odom = np.array((0.0, 0.0, 0.3))
@@ -43,7 +47,10 @@ def simulate(duration=150.0, outage=OUTAGE, jump=JUMP, robust="cauchy", seed=0):
             if jump[0] <= t < jump[1]:
                 fx += 30.0
             fix = (fx, fy)
-            est.add_gnss(t, fx, fy, GNSS_SIGMA, GNSS_SIGMA)
+            in_flight.append((t + rng.uniform(0.0, max_delay), t, fx, fy))
+        for _arrival, stamp, fx, fy in sorted(f for f in in_flight if f[0] <= t + 1e-9):
+            est.add_gnss(stamp, fx, fy, GNSS_SIGMA, GNSS_SIGMA)
+        in_flight = [f for f in in_flight if f[0] > t + 1e-9]
         pose = est.pose()
         if pose is not None:
             log.append((t, *true[:2], pose[0], pose[1], *dead[:2], *fix))
@@ -87,3 +94,63 @@ def test_without_robust_model_the_jump_pulls():
     log, _ = simulate(duration=JUMP[1] + 1.0, outage=(0.0, 0.0), robust="none")
     w = log[(log[:, 0] >= JUMP[0]) & (log[:, 0] < JUMP[1] + 1.0)]
     assert _err(w, 3, 4).max() > 3.0
+
+
+def test_late_fixes_go_on_the_keyframes_of_their_time():
+    # A GNSS driver up to 1 s behind the odometry (fixes out of order among themselves too):
+    # a keyframe stamped back in time would break iSAM2's marginalisation for good.
+    log, est = simulate(duration=OUTAGE[0], max_delay=1.0)
+    w = log[log[:, 0] >= 5.0]
+    fused = np.sqrt(np.mean(_err(w, 3, 4) ** 2))
+    assert est.solver_failures == 0, est.last_failure
+    assert fused < 0.5 * np.sqrt(np.mean(_err(w, 7, 8) ** 2)) and fused < 0.5
+    # Dropped: the two fixes stamped before the one that arrived first and anchored the graph.
+    assert est.gnss_used > 250 and est.gnss_dropped == 2
+
+
+def test_a_fix_older_than_the_window_is_dropped():
+    est = FactorGraphEstimator(lag=2.0, keyframe_period=0.2)
+    est.add_gnss(0.0, 0.0, 0.0, 0.5, 0.5)
+    for k in range(1, 51):  # 5 s east at 1 m/s
+        est.add_odometry(k * 0.1, k * 0.1, 0.0, 0.0)
+    before = est.pose()
+    est.add_gnss(1.0, 40.0, 40.0, 0.5, 0.5)  # 4 s old: its keyframe is marginalised
+    assert est.gnss_dropped == 1 and est.solver_failures == 0
+    assert est.pose() == pytest.approx(before)
+    est.add_gnss(4.4, 4.4, 0.5, 0.5, 0.5)  # 0.6 s old: on the keyframe of 4.4 s
+    assert est.gnss_used == 1 and est.gnss_dropped == 1  # (the first fix anchors, not counted)
+    assert est.pose()[1] > 0.2  # pulled sideways towards the fix, y = 0.5
+
+
+class _FailingOnce:
+    """A smoother whose next update raises as GTSAM's marginalisation did in the matrix."""
+
+    def __init__(self, smoother):
+        self._smoother, self.failed = smoother, False
+
+    def __getattr__(self, name):
+        return getattr(self._smoother, name)
+
+    def update(self, *args):
+        if not self.failed:
+            self.failed = True
+            raise IndexError("BayesTreeMarginalizationHelper: key 'x7' has no clique")
+        return self._smoother.update(*args)
+
+
+def test_a_failing_update_anchors_the_graph_again_at_the_last_estimate():
+    est = FactorGraphEstimator(lag=2.0, keyframe_period=0.2)
+    est.add_gnss(0.0, 0.0, 0.0, 0.5, 0.5)
+    for k in range(0, 11):
+        est.add_odometry(k * 0.1, k * 0.1, 0.0, 0.0)
+    est._smoother = _FailingOnce(est._smoother)
+    for k in range(11, 14):  # the keyframe of 1.2 s fails
+        est.add_odometry(k * 0.1, k * 0.1, 0.0, 0.0)
+    assert est.solver_failures == 1 and "no clique" in est.last_failure
+    assert est.pose() == pytest.approx((1.3, 0.0, 0.0), abs=1e-6)
+    for k in range(14, 41):  # it goes on: odometry and fixes are used again
+        est.add_odometry(k * 0.1, k * 0.1, 0.0, 0.0)
+        if k % 5 == 0:
+            est.add_gnss(k * 0.1, k * 0.1, 0.0, 0.5, 0.5)
+    assert est.solver_failures == 1 and est.gnss_used == 6
+    assert est.pose() == pytest.approx((4.0, 0.0, 0.0), abs=1e-3)

@@ -68,6 +68,51 @@ def test_straight_drive_with_gnss_writes_pose_and_covariance():
     assert (pose.pose.x, pose.pose.y) == pytest.approx((50.0, 5.0), abs=0.2)
 
 
+class _Failing:
+    """A smoother whose updates raise (until the recovery replaces it with a new one)."""
+
+    def __init__(self, smoother):
+        self._smoother = smoother
+
+    def __getattr__(self, name):
+        return getattr(self._smoother, name)
+
+    def update(self, *args):
+        raise IndexError("key 'x176' has no clique in the Bayes tree")
+
+
+def test_a_gnss_driver_late_against_the_odometry_and_a_solver_failure(caplog):
+    # The campus matrix row under load: fixes reached NavState ~0.5 s after the odometry of
+    # their time; GTSAM's marginalisation broke on the first and raised every cycle after.
+    caplog.set_level("WARNING", logger="easynav")
+    projection = UtmProjection(*ORIGIN)
+    plugin = _plugin()
+    nav_state = NavState()
+    rng = np.random.default_rng(1)
+    for k in range(1, 401):  # 40 s at 0.5 m/s east, odometry 5 % long
+        t = k * 0.1
+        plugin.add_odometry(Odometry(header=Header(t, "odom"),
+                                     pose=Pose.from_xy_yaw(0.525 * t, 0.0, 0.0)))
+        if k % 2 == 0 and k > 5:
+            stamp = t - 0.5
+            lat, lon = projection.inverse(0.5 * stamp + rng.normal(0, 0.3), rng.normal(0, 0.3))
+            nav_state.set("gps", GNSSPerception(
+                latitude=lat, longitude=lon, altitude=ORIGIN[2],
+                position_covariance=np.eye(3) * 0.09,
+                position_covariance_type=COVARIANCE_TYPE_DIAGONAL_KNOWN, status=STATUS_FIX,
+                stamp=stamp))
+            nav_state.add_to_group("gnss", "gps")
+        if k == 200:  # and GTSAM raising once more, whatever the cause
+            plugin.estimator._smoother = _Failing(plugin.estimator._smoother)
+        plugin.update_rt(nav_state)
+        if k >= 20:
+            pose = nav_state.get("robot_pose", Odometry)
+            assert math.hypot(pose.pose.x - 0.5 * t, pose.pose.y) < 0.6, t
+    assert plugin.estimator.gnss_used > 150 and plugin.estimator.solver_failures == 1
+    warnings = [r.getMessage() for r in caplog.records if "GTSAM failed" in r.getMessage()]
+    assert len(warnings) == 1 and "no clique" in warnings[0]
+
+
 def test_bad_parameters_name_the_culprit():
     with pytest.raises(PluginConfigurationError, match="robust"):
         _plugin(robust="magic")

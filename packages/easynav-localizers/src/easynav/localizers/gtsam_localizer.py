@@ -37,7 +37,8 @@ class GtsamLocalizer(LocalizerMethodBase):
     between-factors; the IMU heading is a yaw prior; GNSS fixes (the first member of NavState
     group ``gnss``, UTM via pyproj around ``latitude_origin``/``longitude_origin``) are
     position priors with a robust noise model (``robust``, ``robust_k``) so jumps get no
-    weight; a window of ``lag`` s keeps the cost flat over hours. ``robot_pose`` carries the
+    weight; a fix that arrives after later odometry goes on the keyframe of its stamp; a window
+    of ``lag`` s keeps the cost flat over hours. ``robot_pose`` carries the
     last keyframe's marginal covariance. ``initialpose`` / ``on_last_known_pose`` re-anchor
     the graph (GNSS shifted to agree).
 
@@ -98,6 +99,7 @@ class GtsamLocalizer(LocalizerMethodBase):
         # odometry message's stamp, moving at that message's twist (body frame).
         self._odom_stamp: float | None = None
         self._twist: tuple[float, float, float] | None = None
+        self._failures_seen = 0
 
     def on_initialize(self) -> None:
         from easynav.core.plugins import PluginConfigurationError
@@ -120,6 +122,7 @@ class GtsamLocalizer(LocalizerMethodBase):
             self._fix_stamp = None
             self._odom_stamp = None
             self._twist = None
+            self._failures_seen = 0
         if self.context.node is not None:
             self._create_ros()
 
@@ -181,6 +184,12 @@ class GtsamLocalizer(LocalizerMethodBase):
                     self._add_fix(value)
             pose = self.estimator.pose()
             cov = self.estimator.covariance()
+            failures, failure = self.estimator.solver_failures, self.estimator.last_failure
+        if failures > self._failures_seen:
+            self._failures_seen = failures
+            self._throttle.warn(self.logger, "solver", (
+                f"{self.plugin_name}: GTSAM failed ({failure}); the graph is anchored again at "
+                f"the last estimate ({failures} time(s) so far)"))
         if pose is None:
             self._throttle.warn(self.logger, "no-fix", f"{self.plugin_name}: no GNSS fix yet")
             return

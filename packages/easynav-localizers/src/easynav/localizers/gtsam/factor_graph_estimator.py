@@ -4,6 +4,7 @@ and GNSS positions."""
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import numpy as np
 
@@ -26,11 +27,18 @@ class FactorGraphEstimator:
     - :meth:`add_imu_yaw`: the latest IMU heading becomes a yaw-only prior on the next keyframe.
     - :meth:`add_gnss`: a position-only prior on a new keyframe, with a robust noise model
       (``robust``: ``cauchy``, ``huber``, ``tukey`` or ``none``, scale ``robust_k`` in σ units):
-      a jump of many σ gets (almost) no weight.
+      a jump of many σ gets (almost) no weight. A fix stamped before the last keyframe (a GNSS
+      driver late against the odometry) goes on the keyframe nearest its stamp, the smoother's
+      reason to be: keyframe stamps must only grow (iSAM2's fixed-lag marginalisation breaks for
+      good on one that goes back). A late fix with no keyframe within ``keyframe_period`` of its
+      stamp inside the window is dropped (``gnss_dropped``).
     - :meth:`pose` is the last keyframe's estimate composed with the odometry since;
       :meth:`covariance` the last keyframe's marginal covariance.
 
     The first GNSS fix (or :meth:`reset`) anchors the graph; before that there is no estimate.
+    Should GTSAM still raise in an update, the graph is anchored again at the last estimate
+    (covariance doubled): ``solver_failures`` counts it and ``last_failure`` says what GTSAM
+    said, so the plugin can warn, and the next inputs go on as after a reset.
     Raises ImportError naming the extra when gtsam is missing. Thread contract: none (the
     plugin serialises calls).
     """
@@ -61,8 +69,12 @@ class FactorGraphEstimator:
         self._delta = gtsam.Pose2()  # odometry since the last keyframe
         self._travel = [0.0, 0.0]  # metres, radians since the last keyframe
         self._pending_yaw: tuple[float, float] | None = None
+        self._keyframes: deque[tuple[float, int]] = deque()  # (stamp, index) inside the window
         self.gnss_rejected = 0
         self.gnss_used = 0
+        self.gnss_dropped = 0
+        self.solver_failures = 0
+        self.last_failure = ""
 
     # -- inputs --------------------------------------------------------------------------------
     @property
@@ -101,13 +113,11 @@ class FactorGraphEstimator:
                          "huber": g.noiseModel.mEstimator.Huber,
                          "tukey": g.noiseModel.mEstimator.Tukey}[self.robust]
             noise = g.noiseModel.Robust.Create(estimator.Create(self.robust_k), noise)
+        if stamp < self._key_time:
+            self._add_late_gnss(stamp, x, y, sigma_x, sigma_y, noise)
+            return
         predicted = self._estimate.compose(self._delta)
-        # Counted (not decided) here: the robust kernel does the down-weighting in the solver.
-        if math.hypot((x - predicted.x()) / sigma_x, (y - predicted.y()) / sigma_y) > \
-                3.0 * self.robust_k:
-            self.gnss_rejected += 1
-        else:
-            self.gnss_used += 1
+        self._count_gnss(x, y, sigma_x, sigma_y, predicted)
         self._keyframe(stamp, [("prior", g.Pose2(x, y, predicted.theta()), noise)])
 
     def reset(self, stamp: float, x: float, y: float, yaw: float, covariance: np.ndarray) -> None:
@@ -126,6 +136,7 @@ class FactorGraphEstimator:
         stamps.insert((key, stamp))
         self._smoother.update(graph, values, stamps)
         self._key_time = stamp
+        self._keyframes = deque([(stamp, 0)])
         self._estimate = g.Pose2(x, y, yaw)
         self._cov = np.diag(sigmas**2)
         self._delta = g.Pose2()
@@ -166,10 +177,59 @@ class FactorGraphEstimator:
         values.insert(key, guess)
         stamps = g.FixedLagSmootherKeyTimestampMap()
         stamps.insert((key, stamp))
-        self._smoother.update(graph, values, stamps)
+        try:
+            self._smoother.update(graph, values, stamps)
+            estimate = self._smoother.calculateEstimatePose2(key)
+            cov = np.asarray(self._smoother.marginalCovariance(key))
+        except Exception as exc:  # GTSAM's internal errors: IndexError, ValueError, RuntimeError
+            self._recover(stamp, guess, exc)
+            return
         self._k += 1
         self._key_time = stamp
-        self._estimate = self._smoother.calculateEstimatePose2(key)
-        self._cov = np.asarray(self._smoother.marginalCovariance(key))
+        self._keyframes.append((stamp, self._k))
+        while self._keyframes[0][0] < stamp - self.lag:  # marginalised by this update
+            self._keyframes.popleft()
+        self._estimate, self._cov = estimate, cov
         self._delta = g.Pose2()
         self._travel = [0.0, 0.0]
+
+    def _add_late_gnss(self, stamp: float, x: float, y: float, sigma_x: float, sigma_y: float,
+                       noise) -> None:
+        """A fix older than the last keyframe: a prior on the keyframe nearest its stamp among
+        those the next update keeps (no new key, so nothing more is marginalised)."""
+        g = self._g
+        oldest = self._key_time - self.lag + self.keyframe_period  # clear of marginalisation
+        near = [(abs(ks - stamp), k) for ks, k in self._keyframes if ks >= oldest]
+        if not near or min(near)[0] > self.keyframe_period:
+            self.gnss_dropped += 1
+            return
+        key = g.symbol("x", min(near)[1])
+        last = g.symbol("x", self._k)
+        try:
+            at_fix = self._smoother.calculateEstimatePose2(key)
+            self._count_gnss(x, y, sigma_x, sigma_y, at_fix)
+            graph = g.NonlinearFactorGraph()
+            graph.add(g.PriorFactorPose2(key, g.Pose2(x, y, at_fix.theta()), noise))
+            self._smoother.update(graph, g.Values(), g.FixedLagSmootherKeyTimestampMap())
+            estimate = self._smoother.calculateEstimatePose2(last)
+            cov = np.asarray(self._smoother.marginalCovariance(last))
+        except Exception as exc:  # GTSAM's internal errors, as in _keyframe
+            self._recover(self._key_time, self._estimate.compose(self._delta), exc)
+            return
+        self._estimate, self._cov = estimate, cov
+
+    def _count_gnss(self, x: float, y: float, sigma_x: float, sigma_y: float, predicted) -> None:
+        # Counted (not decided) here: the robust kernel does the down-weighting in the solver.
+        if math.hypot((x - predicted.x()) / sigma_x, (y - predicted.y()) / sigma_y) > \
+                3.0 * self.robust_k:
+            self.gnss_rejected += 1
+        else:
+            self.gnss_used += 1
+
+    def _recover(self, stamp: float, keyframe, exc: Exception) -> None:
+        """GTSAM raised: anchor a new graph at ``keyframe`` (the estimate the failed update
+        would have refined), so one failure does not end localisation."""
+        self.solver_failures += 1
+        self.last_failure = f"{type(exc).__name__}: {exc}"
+        self.reset(max(stamp, self._key_time), keyframe.x(), keyframe.y(), keyframe.theta(),
+                   2.0 * self._cov)
