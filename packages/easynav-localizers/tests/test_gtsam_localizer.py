@@ -116,3 +116,5 @@ def test_a_gnss_driver_late_against_the_odometry_and_a_solver_failure(caplog):
 def test_bad_parameters_name_the_culprit():
     with pytest.raises(PluginConfigurationError, match="robust"):
         _plugin(robust="magic")
+    with pytest.raises(PluginConfigurationError, match=r"g\.lag: .*keyframe periods"):
+        _plugin(lag=0.3, keyframe_period=0.2)

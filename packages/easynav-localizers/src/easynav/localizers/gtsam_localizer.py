@@ -37,10 +37,10 @@ class GtsamLocalizer(LocalizerMethodBase):
     between-factors; the IMU heading is a yaw prior; GNSS fixes (the first member of NavState
     group ``gnss``, UTM via pyproj around ``latitude_origin``/``longitude_origin``) are
     position priors with a robust noise model (``robust``, ``robust_k``) so jumps get no
-    weight; a fix that arrives after later odometry goes on the keyframe of its stamp; a window
-    of ``lag`` s keeps the cost flat over hours. ``robot_pose`` carries the
-    last keyframe's marginal covariance. ``initialpose`` / ``on_last_known_pose`` re-anchor
-    the graph (GNSS shifted to agree).
+    weight; a fix that arrives after later odometry goes on the keyframe of its stamp, moved by
+    the odometry between; a window of ``lag`` s keeps the cost flat over hours. ``robot_pose``
+    carries the last keyframe's marginal covariance. ``initialpose`` / ``on_last_known_pose``
+    re-anchor the graph (GNSS shifted to agree).
 
     ROS: subscribes ``odom_topic`` (Odometry) and ``imu_topic`` (Imu) on the RT-side node;
     broadcasts ``map → odom`` from the estimate and the ``odom → robot`` TF. All work in
@@ -48,7 +48,8 @@ class GtsamLocalizer(LocalizerMethodBase):
 
     Thread contract: callbacks only queue; ``update_rt`` (RT thread) runs the smoother under a
     lock shared with ``on_last_known_pose``. Exceptions: ImportError naming the extra without
-    gtsam or pyproj; PluginConfigurationError for a bad origin.
+    gtsam or pyproj; PluginConfigurationError for a bad origin or a ``lag`` shorter than two
+    keyframe periods.
     """
 
     #: Sensors the robot must have (the integration matrix runs it only in worlds that give them).
@@ -112,11 +113,15 @@ class GtsamLocalizer(LocalizerMethodBase):
             projection = UtmProjection(v.latitude_origin, v.longitude_origin, v.altitude_origin)
         except ValueError as exc:
             raise PluginConfigurationError(f"{self.plugin_name}.latitude_origin: {exc}") from None
-        with self._lock:
-            self._projection = projection
-            self.estimator = FactorGraphEstimator(
+        try:
+            estimator = FactorGraphEstimator(
                 lag=v.lag, keyframe_period=v.keyframe_period, odom_sigma_xy=v.odom_sigma_xy,
                 odom_sigma_yaw=v.odom_sigma_yaw, robust=v.robust, robust_k=v.robust_k)
+        except ValueError as exc:
+            raise PluginConfigurationError(f"{self.plugin_name}.lag: {exc}") from None
+        with self._lock:
+            self._projection = projection
+            self.estimator = estimator
             self._queue.clear()
             self._offset = np.zeros(2)
             self._fix_stamp = None
