@@ -3,6 +3,7 @@ marginal covariance, on_last_known_pose."""
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -37,25 +38,36 @@ def _plugin(**params):
     return plugin
 
 
+@functools.cache
+def _projection() -> UtmProjection:
+    return UtmProjection(*ORIGIN)  # built once: a pyproj transformer takes tens of ms
+
+
+def _drive_east(plugin, nav_state, t, rng, fix_delay=None):
+    """One 0.1 s step of a robot at 0.5 m/s east (odometry 5 % long); with ``fix_delay``, a
+    fix (σ 0.3 m) of where it was that long ago."""
+    plugin.add_odometry(Odometry(header=Header(t, "odom"),
+                                 pose=Pose.from_xy_yaw(0.525 * t, 0.0, 0.0)))
+    if fix_delay is not None:
+        stamp = t - fix_delay
+        lat, lon = _projection().inverse(0.5 * stamp + rng.normal(0, 0.3), rng.normal(0, 0.3))
+        nav_state.set("gps", GNSSPerception(
+            latitude=lat, longitude=lon, altitude=ORIGIN[2],
+            position_covariance=np.eye(3) * 0.09,
+            position_covariance_type=COVARIANCE_TYPE_DIAGONAL_KNOWN, status=STATUS_FIX,
+            stamp=stamp))
+        nav_state.add_to_group("gnss", "gps")
+
+
 def test_straight_drive_with_gnss_writes_pose_and_covariance():
-    projection = UtmProjection(*ORIGIN)
     plugin = _plugin()
     nav_state = NavState()
     rng = np.random.default_rng(0)
-    for k in range(1, 201):  # 20 s at 0.5 m/s east, odometry 5 % long
+    for k in range(1, 201):  # 20 s, fixes at 5 Hz
         t = k * 0.1
-        plugin.add_odometry(Odometry(header=Header(t, "odom"),
-                                     pose=Pose.from_xy_yaw(0.525 * t, 0.0, 0.0)))
         plugin.add_imu(ImuPerception(orientation=np.array(yaw_to_quaternion(0.0)),
                                      orientation_covariance=np.eye(3) * 1e-4, stamp=t))
-        if k % 2 == 0:
-            lat, lon = projection.inverse(0.5 * t + rng.normal(0, 0.3), rng.normal(0, 0.3))
-            nav_state.set("gps", GNSSPerception(
-                latitude=lat, longitude=lon, altitude=ORIGIN[2],
-                position_covariance=np.eye(3) * 0.09,
-                position_covariance_type=COVARIANCE_TYPE_DIAGONAL_KNOWN, status=STATUS_FIX,
-                stamp=t))
-            nav_state.add_to_group("gnss", "gps")
+        _drive_east(plugin, nav_state, t, rng, fix_delay=0.0 if k % 2 == 0 else None)
         plugin.update_rt(nav_state)
     pose = nav_state.get("robot_pose", Odometry)
     assert math.hypot(pose.pose.x - 10.0, pose.pose.y) < 0.5  # odometry alone: 10.5
@@ -85,23 +97,12 @@ def test_a_gnss_driver_late_against_the_odometry_and_a_solver_failure(caplog):
     # The campus matrix row under load: fixes reached NavState ~0.5 s after the odometry of
     # their time; GTSAM's marginalisation broke on the first and raised every cycle after.
     caplog.set_level("WARNING", logger="easynav")
-    projection = UtmProjection(*ORIGIN)
     plugin = _plugin()
     nav_state = NavState()
     rng = np.random.default_rng(1)
-    for k in range(1, 401):  # 40 s at 0.5 m/s east, odometry 5 % long
+    for k in range(1, 401):  # 40 s, fixes at 5 Hz, 0.5 s late
         t = k * 0.1
-        plugin.add_odometry(Odometry(header=Header(t, "odom"),
-                                     pose=Pose.from_xy_yaw(0.525 * t, 0.0, 0.0)))
-        if k % 2 == 0 and k > 5:
-            stamp = t - 0.5
-            lat, lon = projection.inverse(0.5 * stamp + rng.normal(0, 0.3), rng.normal(0, 0.3))
-            nav_state.set("gps", GNSSPerception(
-                latitude=lat, longitude=lon, altitude=ORIGIN[2],
-                position_covariance=np.eye(3) * 0.09,
-                position_covariance_type=COVARIANCE_TYPE_DIAGONAL_KNOWN, status=STATUS_FIX,
-                stamp=stamp))
-            nav_state.add_to_group("gnss", "gps")
+        _drive_east(plugin, nav_state, t, rng, fix_delay=0.5 if k % 2 == 0 and k > 5 else None)
         if k == 200:  # and GTSAM raising once more, whatever the cause
             plugin.estimator._smoother = _Failing(plugin.estimator._smoother)
         plugin.update_rt(nav_state)
