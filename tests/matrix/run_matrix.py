@@ -8,7 +8,10 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
   --speed-up the simulation's speed (x real time; EasyNav's loops keep their wall-clock rates,
              so its RT cycles per simulated second drop by as much). On a 2-core machine one
              mission at x2 ran at x1.9-2.0 with the same verdict and figures as at x1 (the
-             campus with MPPI and with VFF): `make matrix` runs it at x2, one at a time
+             campus with MPPI and with VFF): `make matrix` runs it at x2, one at a time.
+             At x4 a campus mission ran at x3.1-3.8 (EasyNav, not the simulator, takes the
+             cores): half the time again, and a harder test (a quarter of the RT cycles per
+             simulated second); docs/matrix.md has rows of x1, x2 and x4, each row says which
   --jobs N   N missions at once, each in a process of its own (a mission takes about a core
              at x1: N above the number of cores slows every run and can fail them)
   --results  where each finished run is kept, one JSON line per run (default
