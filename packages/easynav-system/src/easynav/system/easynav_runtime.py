@@ -48,7 +48,11 @@ class EasyNavRuntime:
       entities destroyed while the EventsExecutor still serves them, abort the interpreter
       (exit code 134).
 
-    Thread contract: all public methods from the owner's (main) thread.
+    Thread contract: all public methods from the owner's (main) thread. With
+    ``install_signal_handlers`` the first SIGINT or SIGTERM is only noted by its handler and
+    becomes a stop request in ``wait()`` or ``stop()`` (a handler must take no lock: it runs in
+    the main thread, perhaps while that thread holds the one it would take); a second one exits
+    at once with code 130.
     """
 
     def __init__(
@@ -82,6 +86,7 @@ class EasyNavRuntime:
         self._stopped = False
         self._froze_gc = False
         self._signals = 0
+        self._signal_name: str | None = None  # the first signal's, set by its handler
         if install_signal_handlers and threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGINT, self._on_signal)
             signal.signal(signal.SIGTERM, self._on_signal)
@@ -100,7 +105,17 @@ class EasyNavRuntime:
             # A second signal while stopping: leave now (the driver may keep the last command).
             sys.stderr.write("easynav: second signal, exiting immediately\n")
             sys.exit(130)
-        self.requests.post_shutdown(f"received {signal.Signals(signum).name}", 0)
+        # Only noted here; wait() (or stop()) posts the shutdown. Python runs a handler in the
+        # main thread between two bytecodes, which may be while that thread holds the lock of the
+        # very event post_shutdown sets (Event.wait holds it on entry and exit): setting it here
+        # deadlocked the process, one SIGTERM in ten with the dummy system, until a second
+        # signal killed it without a controlled stop.
+        self._signal_name = signal.Signals(signum).name
+
+    def _post_signal_shutdown(self) -> None:
+        name = self._signal_name
+        if name is not None and self.requests.shutdown_reason is None:
+            self.requests.post_shutdown(f"received {name}", 0)
 
     def start(self) -> bool:
         """Start the loops, then configure and activate. False (and ``error``) on failure."""
@@ -162,19 +177,23 @@ class EasyNavRuntime:
             self.logger.warning(message)
 
     def wait(self, timeout: float | None = None) -> bool:
-        """Block until a stop is requested (True) or ``timeout`` passes (False)."""
+        """Block until a stop is requested (True) or ``timeout`` passes (False).
+
+        A SIGINT or SIGTERM received is posted as a stop request here (within 0.1 s)."""
         end = None if timeout is None else time.monotonic() + timeout
         event = self.requests.shutdown_event
         while True:
+            self._post_signal_shutdown()
             remaining = None if end is None else end - time.monotonic()
             if remaining is not None and remaining <= 0:
-                return False
+                return event.is_set()
             # Short waits keep the main thread responsive to signals.
             if event.wait(0.1 if remaining is None else min(0.1, remaining)):
                 return True
 
     def stop(self) -> RuntimeResult:
         """Controlled stop; returns the exit code and reason. Idempotent."""
+        self._post_signal_shutdown()  # a signal received while no one waited
         reason = self.requests.shutdown_reason or "stop requested"
         code = self.requests.shutdown_exit_code
         if self._stopped:
