@@ -88,3 +88,42 @@ def test_a_kernel_without_a_disk_cache_is_left_as_it_is():
     hooked = compile_in_child(dispatcher, "nowhere:nothing")
     assert hooked is dispatcher
     assert "_compile_for_args" not in vars(dispatcher)
+
+
+FROM_A_REALTIME_THREAD = """
+import os, sys, threading
+import numpy as np
+from easynav.common import compiled_kernels
+compiled_kernels.enable_child_compilation(True)
+from sample_kernel import weighted_sum
+
+def loop_step():
+    # What an EasyNav loop is: a SCHED_FIFO thread whose step meets a new kernel signature.
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(70))
+    except PermissionError:
+        print("no SCHED_FIFO here")
+        return
+    print(weighted_sum(np.arange(4.0), 2.0))
+
+thread = threading.Thread(target=loop_step)
+thread.start()
+thread.join()
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "SCHED_FIFO"), reason="SCHED_FIFO is Linux's")
+def test_a_child_started_from_a_realtime_loop_compiles_at_normal_priority(tmp_path):
+    """A child started by a SCHED_FIFO loop inherits its policy; compiling for seconds at it
+    kept the other processes of its core (a simulator, a test's nodes) from running."""
+    policies = tmp_path / "child_policy.txt"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+               EASYNAV_TEST_CHILD_POLICY_FILE=str(policies),
+               PYTHONPATH=os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]))
+    done = subprocess.run([sys.executable, "-c", FROM_A_REALTIME_THREAD], env=env,
+                          capture_output=True, text=True, timeout=300, cwd=HERE)
+    assert done.returncode == 0, done.stderr
+    if "no SCHED_FIFO here" in done.stdout:
+        pytest.skip("this machine refuses SCHED_FIFO (RLIMIT_RTPRIO 0, no CAP_SYS_NICE)")
+    assert done.stdout.split()[-1] == "12.0"
+    assert policies.read_text().split() == [str(os.SCHED_OTHER)]

@@ -16,12 +16,19 @@ where numba's dispatcher goes only when no compiled version matches the argument
 The hook is off until :func:`enable_child_compilation` (the ``easynav run`` process turns it
 on): tests and scripts compile in-process, as numba does. Whatever goes wrong in the child
 (killed, no writable cache) ends in numba's own in-process compilation, never in an error.
+
+The child compiles at normal priority. It is started from the thread whose kernel needs it,
+usually one of EasyNav's SCHED_FIFO loops, and a process inherits its creator's scheduling: a
+child compiling for seconds at SCHED_FIFO 70 or 80 keeps the other processes of its core (the
+simulator, a second system, a test's ROS nodes) from running for as long (seen at a matrix
+run's start: a compile child of the non-RT loop at 99 % of a core, SCHED_FIFO 70, 8 s in).
 """
 
 from __future__ import annotations
 
 import importlib
 import logging
+import os
 import pickle
 import subprocess
 import sys
@@ -113,7 +120,25 @@ def resolve(locator: str):
     return found
 
 
+def leave_realtime_scheduling() -> None:
+    """Put the calling thread back on the normal scheduling policy (SCHED_OTHER, nice
+    unchanged) if it inherited a real-time one; nothing elsewhere than on Linux.
+
+    Lowering one's own policy needs no privilege. Thread contract: affects only the calling
+    thread (``sched_setscheduler`` with pid 0); a process that calls it first thing runs its
+    later threads at normal priority too. Exceptions: none.
+    """
+    if not hasattr(os, "sched_setscheduler"):
+        return
+    try:
+        if os.sched_getscheduler(0) in (os.SCHED_FIFO, os.SCHED_RR):
+            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+    except OSError as error:  # not expected: lowering is always allowed
+        _LOG.warning("could not leave real-time scheduling: %s", error)
+
+
 def _child_main() -> int:
+    leave_realtime_scheduling()  # before anything heavy: see the module's docstring
     locator, signature = pickle.loads(sys.stdin.buffer.read())
     dispatcher = resolve(locator)
     dispatcher.compile(signature)  # compiled and written to numba's cache
