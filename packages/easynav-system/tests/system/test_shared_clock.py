@@ -59,3 +59,54 @@ def test_no_subscription_while_no_node_is_on_simulated_time(ros_local):
     nodes[1].set_parameters([Parameter("use_sim_time", value=True)])
     assert shared.subscription is not None
     assert _clock_subscriptions(nodes) == 1
+
+
+def test_nodes_made_while_deferred_never_subscribe_and_other_threads_still_do(ros_local):
+    import threading
+
+    from easynav.system.ros.rclpy_private import clock_subscriptions_deferred
+
+    sim = [Parameter("use_sim_time", value=True)]
+    made_elsewhere = []
+    with clock_subscriptions_deferred():
+        deferred = [ros_local.create_node(f"deferred_{i}", parameter_overrides=sim)
+                    for i in range(2)]
+        worker = threading.Thread(target=lambda: made_elsewhere.append(
+            ros_local.create_node("other_thread", parameter_overrides=sim)))
+        worker.start()
+        worker.join()
+    assert _clock_subscriptions(deferred) == 0
+    assert _clock_subscriptions(made_elsewhere) == 1
+    after = ros_local.create_node("after", parameter_overrides=sim)
+    assert _clock_subscriptions([after]) == 1
+
+    shared = SharedClockSubscription(deferred[0], deferred)
+    assert _clock_subscriptions(deferred) == 1
+    assert shared.subscription is not None
+
+
+def test_a_system_on_simulated_time_creates_one_clock_subscription_and_destroys_none(
+    params_file, runtime_factory, monkeypatch
+):
+    """Each node's own /clock subscription, created then destroyed at once for the shared one,
+    left a simulator blind to every later subscription of the system (its clock, tf, tf_static)
+    4 starts in 100: the test of a simulator restarted under a running system failed in CI."""
+    from rclpy.node import Node
+
+    from easynav.system.testing.system_fixtures import system_params
+
+    created = []
+    create_subscription = Node.create_subscription
+
+    def counting(node, msg_type, topic, *args, **kwargs):
+        if topic in ("/clock", "clock"):
+            created.append(node.get_name())
+        return create_subscription(node, msg_type, topic, *args, **kwargs)
+
+    monkeypatch.setattr(Node, "create_subscription", counting)
+    nodes = ("system_node", "controller_node", "localizer_node", "planner_node",
+             "maps_manager_node", "sensors_node", "recovery_node")
+    runtime = runtime_factory(params_file(system_params(
+        **{f"{node}.use_sim_time": True for node in nodes})))
+    assert runtime.system_node.rt_io_node.get_parameter("use_sim_time").value is True
+    assert created == ["sensors_node"]  # the shared subscription, on its host

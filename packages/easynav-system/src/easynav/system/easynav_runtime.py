@@ -17,6 +17,7 @@ from easynav.core.nav_state import NavState
 from easynav.system.cycle_loop import CycleLoop
 from easynav.system.executor import EXECUTOR_ENV, make_executor  # noqa: F401 (re-exported)
 from easynav.system.process_tuning import tune_malloc
+from easynav.system.ros.rclpy_private import clock_subscriptions_deferred
 from easynav.system.system_node import SystemNode
 
 #: SCHED_FIFO priority of the non-RT loop with ``use_real_time``: below the RT loop's 80.
@@ -71,7 +72,11 @@ class EasyNavRuntime:
         rclpy.init(args=args, context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.nav_state = NavState()
         self.namespace = namespace
-        self.system_node = SystemNode(self.nav_state, namespace, context=self.context)
+        # On use_sim_time the nodes share one /clock subscription (SharedClockSubscription):
+        # their own are never created, for one created and destroyed at once could leave this
+        # participant's later subscriptions unseen by a simulator (clock_subscriptions_deferred).
+        with clock_subscriptions_deferred():
+            self.system_node = SystemNode(self.nav_state, namespace, context=self.context)
         self.requests = self.system_node.requests
         self.error = ""
         self.rt_executor = make_executor(self.context)

@@ -22,7 +22,9 @@ class SharedClockSubscription:
     one subscription on ``host`` (its executor serves it) hands each message to every time
     source whose node is on simulated time, exactly as its own subscription did
     (``TimeSource.clock_callback``). The subscription is created when the first node is on
-    simulated time (same QoS as rclpy's: depth 1, best effort).
+    simulated time (same QoS as rclpy's: depth 1, best effort). Nodes constructed inside
+    ``clock_subscriptions_deferred()`` (the runtime constructs them so) never had their own;
+    others have theirs destroyed here.
 
     Thread contract: construct before the executors spin (the nodes' constructors have run);
     the callback runs in the thread that spins ``host`` (sensors_node: the RT loop), which
