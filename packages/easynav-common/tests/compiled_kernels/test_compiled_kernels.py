@@ -127,3 +127,30 @@ def test_a_child_started_from_a_realtime_loop_compiles_at_normal_priority(tmp_pa
         pytest.skip("this machine refuses SCHED_FIFO (RLIMIT_RTPRIO 0, no CAP_SYS_NICE)")
     assert done.stdout.split()[-1] == "12.0"
     assert policies.read_text().split() == [str(os.SCHED_OTHER)]
+
+
+@pytest.mark.skipif(not hasattr(os, "SCHED_FIFO"), reason="SCHED_FIFO is Linux's")
+def test_the_child_asks_for_the_normal_policy_before_loading_anything(monkeypatch):
+    """The same regression where SCHED_FIFO is refused (the test above skips there): the child
+    main lowers an inherited real-time policy before it resolves the kernel."""
+    import io
+    import pickle
+
+    from easynav.common import compiled_kernels
+
+    calls = []
+    monkeypatch.setattr(os, "sched_getscheduler",
+                        lambda pid: os.SCHED_FIFO | getattr(os, "SCHED_RESET_ON_FORK", 0))
+    monkeypatch.setattr(os, "sched_setscheduler",
+                        lambda pid, policy, param: calls.append(("policy", pid, policy)))
+
+    def resolve(locator):
+        calls.append(("resolve", locator))
+        raise LookupError("stop here")
+
+    monkeypatch.setattr(compiled_kernels, "resolve", resolve)
+    payload = io.BytesIO(pickle.dumps(("sample_kernel:weighted_sum", ())))
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(payload))
+    with pytest.raises(LookupError):
+        compiled_kernels._child_main()
+    assert calls == [("policy", 0, os.SCHED_OTHER), ("resolve", "sample_kernel:weighted_sum")]

@@ -93,32 +93,6 @@ def test_sigterm_also_stops_cleanly(params_file):
     assert "EasyNav stopped: received SIGTERM" in output
 
 
-def test_a_signal_handled_while_the_main_thread_holds_the_stop_events_lock_is_not_lost(
-    params_file, runtime_factory
-):
-    """Python runs a signal handler in the main thread between two bytecodes, possibly inside
-    ``Event.wait`` while that thread holds the event's lock. The handler used to set that event
-    itself: the process deadlocked (one SIGTERM in ten) until a second signal killed it without
-    a controlled stop."""
-    import threading
-
-    runtime = runtime_factory(params_file(system_params()))
-    assert runtime.start(), runtime.error
-    event_lock = runtime.requests.shutdown_event._cond  # what Event.wait holds at moments
-
-    def handler_inside_event_wait() -> None:
-        with event_lock:
-            runtime._on_signal(signal.SIGTERM, None)
-
-    handler = threading.Thread(target=handler_inside_event_wait, daemon=True)
-    handler.start()
-    handler.join(timeout=5.0)
-    assert not handler.is_alive(), "the signal handler blocked on the stop event's lock"
-    assert runtime.wait(timeout=5.0)
-    result = runtime.stop()
-    assert (result.exit_code, result.reason) == (0, "received SIGTERM")
-
-
 def test_run_with_invalid_configuration_exits_2_and_says_why(params_file):
     document = system_params(**{"controller_node.dummy.rt_freq": 1000.0})
     result = subprocess.run(

@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import threading
+
+from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 
+from easynav.system.ros.rclpy_private import clock_subscriptions_deferred
 from easynav.system.shared_clock import SharedClockSubscription
+from easynav.system.testing.system_fixtures import system_params
 
 
 def _clock_subscriptions(nodes) -> int:
@@ -62,15 +67,13 @@ def test_no_subscription_while_no_node_is_on_simulated_time(ros_local):
 
 
 def test_nodes_made_while_deferred_never_subscribe_and_other_threads_still_do(ros_local):
-    import threading
-
-    from easynav.system.ros.rclpy_private import clock_subscriptions_deferred
-
     sim = [Parameter("use_sim_time", value=True)]
     made_elsewhere = []
     with clock_subscriptions_deferred():
-        deferred = [ros_local.create_node(f"deferred_{i}", parameter_overrides=sim)
-                    for i in range(2)]
+        with clock_subscriptions_deferred():  # blocks nest
+            deferred = [ros_local.create_node("deferred_0", parameter_overrides=sim)]
+        deferred.append(ros_local.create_node("deferred_1", parameter_overrides=sim))
+        deferred.append(ros_local.create_node("deferred_wall"))
         worker = threading.Thread(target=lambda: made_elsewhere.append(
             ros_local.create_node("other_thread", parameter_overrides=sim)))
         worker.start()
@@ -84,29 +87,46 @@ def test_nodes_made_while_deferred_never_subscribe_and_other_threads_still_do(ro
     assert _clock_subscriptions(deferred) == 1
     assert shared.subscription is not None
 
+    # A deferred node switched to simulated time later follows the shared subscription.
+    deferred[2].set_parameters([Parameter("use_sim_time", value=True)])
+    assert _clock_subscriptions(deferred) == 1
+    clock_node = ros_local.create_node("clock")
+    publisher = clock_node.create_publisher(Clock, "/clock", 10)
+    assert ros_local.spin_until(lambda: publisher.get_subscription_count() > 0)
+    msg = Clock()
+    msg.clock.sec = 7
+    publisher.publish(msg)
+    assert ros_local.spin_until(lambda: deferred[2].get_clock().now().nanoseconds == 7e9)
+
 
 def test_a_system_on_simulated_time_creates_one_clock_subscription_and_destroys_none(
     params_file, runtime_factory, monkeypatch
 ):
     """Each node's own /clock subscription, created then destroyed at once for the shared one,
     left a simulator blind to every later subscription of the system (its clock, tf, tf_static)
-    4 starts in 100: the test of a simulator restarted under a running system failed in CI."""
-    from rclpy.node import Node
-
-    from easynav.system.testing.system_fixtures import system_params
-
-    created = []
+    a few starts in a hundred: the test of a simulator restarted under a running system failed
+    in CI."""
+    created, destroyed = [], []
     create_subscription = Node.create_subscription
+    destroy_subscription = Node.destroy_subscription
 
-    def counting(node, msg_type, topic, *args, **kwargs):
-        if topic in ("/clock", "clock"):
+    def counting_create(node, msg_type, topic, *args, **kwargs):
+        subscription = create_subscription(node, msg_type, topic, *args, **kwargs)
+        if subscription.topic_name == "/clock":
             created.append(node.get_name())
-        return create_subscription(node, msg_type, topic, *args, **kwargs)
+        return subscription
 
-    monkeypatch.setattr(Node, "create_subscription", counting)
+    def counting_destroy(node, subscription):
+        if subscription.topic_name == "/clock":
+            destroyed.append(node.get_name())
+        return destroy_subscription(node, subscription)
+
+    monkeypatch.setattr(Node, "create_subscription", counting_create)
+    monkeypatch.setattr(Node, "destroy_subscription", counting_destroy)
     nodes = ("system_node", "controller_node", "localizer_node", "planner_node",
              "maps_manager_node", "sensors_node", "recovery_node")
     runtime = runtime_factory(params_file(system_params(
         **{f"{node}.use_sim_time": True for node in nodes})))
     assert runtime.system_node.rt_io_node.get_parameter("use_sim_time").value is True
     assert created == ["sensors_node"]  # the shared subscription, on its host
+    assert destroyed == []

@@ -120,25 +120,29 @@ def resolve(locator: str):
     return found
 
 
-def leave_realtime_scheduling() -> None:
+def _leave_realtime_scheduling() -> None:
     """Put the calling thread back on the normal scheduling policy (SCHED_OTHER, nice
     unchanged) if it inherited a real-time one; nothing elsewhere than on Linux.
 
-    Lowering one's own policy needs no privilege. Thread contract: affects only the calling
-    thread (``sched_setscheduler`` with pid 0); a process that calls it first thing runs its
-    later threads at normal priority too. Exceptions: none.
+    Lowering one's own policy needs no privilege. The child calls it first thing, which is
+    after the interpreter's start-up and this module's import (about 0.2 s, still at the
+    inherited policy). The loops' threads do not set SCHED_RESET_ON_FORK instead: it would
+    reset the threads they start too (MPPI's noise, MH-AMCL's search), and a normal thread
+    preempted while it holds the GIL keeps the RT thread waiting. Thread contract: affects
+    only the calling thread (``sched_setscheduler`` with pid 0). Exceptions: none.
     """
     if not hasattr(os, "sched_setscheduler"):
         return
     try:
-        if os.sched_getscheduler(0) in (os.SCHED_FIFO, os.SCHED_RR):
+        policy = os.sched_getscheduler(0) & ~getattr(os, "SCHED_RESET_ON_FORK", 0)
+        if policy in (os.SCHED_FIFO, os.SCHED_RR):
             os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
     except OSError as error:  # not expected: lowering is always allowed
         _LOG.warning("could not leave real-time scheduling: %s", error)
 
 
 def _child_main() -> int:
-    leave_realtime_scheduling()  # before anything heavy: see the module's docstring
+    _leave_realtime_scheduling()  # before anything heavy: see the module's docstring
     locator, signature = pickle.loads(sys.stdin.buffer.read())
     dispatcher = resolve(locator)
     dispatcher.compile(signature)  # compiled and written to numba's cache

@@ -17,7 +17,6 @@ from easynav.core.nav_state import NavState
 from easynav.system.cycle_loop import CycleLoop
 from easynav.system.executor import EXECUTOR_ENV, make_executor  # noqa: F401 (re-exported)
 from easynav.system.process_tuning import tune_malloc
-from easynav.system.ros.rclpy_private import clock_subscriptions_deferred
 from easynav.system.system_node import SystemNode
 
 #: SCHED_FIFO priority of the non-RT loop with ``use_real_time``: below the RT loop's 80.
@@ -51,9 +50,9 @@ class EasyNavRuntime:
 
     Thread contract: all public methods from the owner's (main) thread. With
     ``install_signal_handlers`` the first SIGINT or SIGTERM is only noted by its handler and
-    becomes a stop request in ``wait()`` or ``stop()`` (a handler must take no lock: it runs in
+    becomes a stop request in ``wait()`` or ``stop()`` (the handler takes no lock: it runs in
     the main thread, perhaps while that thread holds the one it would take); a second one exits
-    at once with code 130.
+    at once with code 130, without a controlled stop.
     """
 
     def __init__(
@@ -72,11 +71,7 @@ class EasyNavRuntime:
         rclpy.init(args=args, context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.nav_state = NavState()
         self.namespace = namespace
-        # On use_sim_time the nodes share one /clock subscription (SharedClockSubscription):
-        # their own are never created, for one created and destroyed at once could leave this
-        # participant's later subscriptions unseen by a simulator (clock_subscriptions_deferred).
-        with clock_subscriptions_deferred():
-            self.system_node = SystemNode(self.nav_state, namespace, context=self.context)
+        self.system_node = SystemNode(self.nav_state, namespace, context=self.context)
         self.requests = self.system_node.requests
         self.error = ""
         self.rt_executor = make_executor(self.context)
@@ -108,7 +103,8 @@ class EasyNavRuntime:
         self._signals += 1
         if self._signals > 1:
             # A second signal while stopping: leave now (the driver may keep the last command).
-            sys.stderr.write("easynav: second signal, exiting immediately\n")
+            # os.write, not sys.stderr: the main thread may be inside a write to stderr.
+            os.write(2, b"easynav: second signal, exiting immediately\n")
             sys.exit(130)
         # Only noted here; wait() (or stop()) posts the shutdown. Python runs a handler in the
         # main thread between two bytecodes, which may be while that thread holds the lock of the
@@ -192,7 +188,7 @@ class EasyNavRuntime:
             remaining = None if end is None else end - time.monotonic()
             if remaining is not None and remaining <= 0:
                 return event.is_set()
-            # Short waits keep the main thread responsive to signals.
+            # Short waits: a signal noted by the handler is posted within 0.1 s.
             if event.wait(0.1 if remaining is None else min(0.1, remaining)):
                 return True
 

@@ -25,7 +25,11 @@ from easynav.system.node_declarations import SYSTEM_PARAMETERS, SYSTEM_PARAMETER
 from easynav.system.node_parameters import NodeParameters
 from easynav.system.planner_node import PlannerNode
 from easynav.system.recovery_node import RecoveryNode
-from easynav.system.ros.rclpy_private import lifecycle_state_label, parameter_override
+from easynav.system.ros.rclpy_private import (
+    clock_subscriptions_deferred,
+    lifecycle_state_label,
+    parameter_override,
+)
 from easynav.system.runtime_reconfiguration import RuntimeReconfiguration
 from easynav.system.safety_supervisor import SafetySupervisor
 from easynav.system.sensors_node import SensorsNode
@@ -68,63 +72,69 @@ class SystemNode(LifecycleNode):
     """
 
     def __init__(self, nav_state, namespace: str = "", **kwargs: Any) -> None:
-        super().__init__("system_node", namespace=namespace, **kwargs)
-        self.params = NodeParameters(self)
-        self.requests = SystemRequests()
-        services = SystemServices(
-            requests=self.requests,
-            tf_info=lambda: get_tf_buffer(self._ns_key()).get_tf_info(),
-        )
-        self.system = SystemContext(
-            nav_state=nav_state, services=services, namespace=self.get_namespace()
-        )
-        self.nav_state = nav_state
-        self.system.robot_geometry = lambda: RobotGeometryRegistry.get(self._ns_key())
-        self.error_message = ""
-        self.active = False
-        # Cycles hold these while running; transitions take them to wait for the cycle to end.
-        self.rt_lock = threading.Lock()
-        self.nort_lock = threading.RLock()  # re-entrant: the non-RT loop may run transitions
-        self.sensors_node = SensorsNode(namespace, self.system, **kwargs)
-        self.maps_manager_node = MapsManagerNode(namespace, self.system, **kwargs)
-        self.localizer_node = LocalizerNode(namespace, self.system, **kwargs)
-        self.planner_node = PlannerNode(namespace, self.system, **kwargs)
-        self.controller_node = ControllerNode(namespace, self.system, **kwargs)
-        self.recovery_node = RecoveryNode(namespace, self.system, **kwargs)
-        self.subnodes: dict[str, ComponentNode] = {
-            "sensors_node": self.sensors_node,
-            "maps_manager_node": self.maps_manager_node,
-            "localizer_node": self.localizer_node,
-            "planner_node": self.planner_node,
-            "controller_node": self.controller_node,
-            "recovery_node": self.recovery_node,
-        }
-        self.navstate_publisher = self.create_publisher(String, "easynav_navstate", 1)
-        # Goal manager, runtime reconfiguration, safety supervisor: see add_extension.
-        self.extensions: list[SystemExtension] = []
-        self.goal_manager = GoalManagerExtension(self)
-        self.add_extension(self.goal_manager)
-        self.reconfiguration = RuntimeReconfiguration(self)
-        self.add_extension(self.reconfiguration)
-        # A hidden companion node spun by the RT loop: what system_node receives on the RT side
-        # (the safety channel's status, TF). rclpy serves a node from one executor only.
-        # It keeps system_node's time (use_sim_time, now and whenever it changes): a params
-        # file names system_node, not it, and on the system time its TF listener never saw a
-        # simulator restart (the buffer kept the old run's transforms) and measured the age of
-        # simulated stamps against the wall clock.
-        rt_kwargs = dict(kwargs)
-        rt_kwargs["parameter_overrides"] = [
-            *(kwargs.get("parameter_overrides") or []),
-            Parameter("use_sim_time", value=self.get_parameter("use_sim_time").value),
-        ]
-        self.rt_io_node = Node("_system_node_rt", namespace=namespace, **rt_kwargs)
-        self.add_post_set_parameters_callback(self._share_sim_time)
-        self.system.rt_node = self.rt_io_node  # plugins' RT-side subscriptions (odometry)
-        # One /clock subscription for the eight nodes instead of eight: sensors_node's (the RT
-        # loop serves it; the ROS graph check sees an EasyNav node waiting for /clock).
-        self.shared_clock = SharedClockSubscription(
-            self.sensors_node, [*self.all_nodes(), self.rt_io_node]
-        )
+        # On use_sim_time the nodes made here share one /clock subscription
+        # (SharedClockSubscription, below): their own are never created. Each one created and
+        # destroyed at once made a simulator miss this system's later subscriptions a few
+        # starts in a hundred (see clock_subscriptions_deferred). Every node made in this block
+        # must be handed to the SharedClockSubscription: on simulated time it has no other.
+        with clock_subscriptions_deferred():
+            super().__init__("system_node", namespace=namespace, **kwargs)
+            self.params = NodeParameters(self)
+            self.requests = SystemRequests()
+            services = SystemServices(
+                requests=self.requests,
+                tf_info=lambda: get_tf_buffer(self._ns_key()).get_tf_info(),
+            )
+            self.system = SystemContext(
+                nav_state=nav_state, services=services, namespace=self.get_namespace()
+            )
+            self.nav_state = nav_state
+            self.system.robot_geometry = lambda: RobotGeometryRegistry.get(self._ns_key())
+            self.error_message = ""
+            self.active = False
+            # Cycles hold these while running; transitions take them to wait for the cycle to end.
+            self.rt_lock = threading.Lock()
+            self.nort_lock = threading.RLock()  # re-entrant: the non-RT loop may run transitions
+            self.sensors_node = SensorsNode(namespace, self.system, **kwargs)
+            self.maps_manager_node = MapsManagerNode(namespace, self.system, **kwargs)
+            self.localizer_node = LocalizerNode(namespace, self.system, **kwargs)
+            self.planner_node = PlannerNode(namespace, self.system, **kwargs)
+            self.controller_node = ControllerNode(namespace, self.system, **kwargs)
+            self.recovery_node = RecoveryNode(namespace, self.system, **kwargs)
+            self.subnodes: dict[str, ComponentNode] = {
+                "sensors_node": self.sensors_node,
+                "maps_manager_node": self.maps_manager_node,
+                "localizer_node": self.localizer_node,
+                "planner_node": self.planner_node,
+                "controller_node": self.controller_node,
+                "recovery_node": self.recovery_node,
+            }
+            self.navstate_publisher = self.create_publisher(String, "easynav_navstate", 1)
+            # Goal manager, runtime reconfiguration, safety supervisor: see add_extension.
+            self.extensions: list[SystemExtension] = []
+            self.goal_manager = GoalManagerExtension(self)
+            self.add_extension(self.goal_manager)
+            self.reconfiguration = RuntimeReconfiguration(self)
+            self.add_extension(self.reconfiguration)
+            # A hidden companion node spun by the RT loop: what system_node receives on the RT side
+            # (the safety channel's status, TF). rclpy serves a node from one executor only.
+            # It keeps system_node's time (use_sim_time, now and whenever it changes): a params
+            # file names system_node, not it, and on the system time its TF listener never saw a
+            # simulator restart (the buffer kept the old run's transforms) and measured the age of
+            # simulated stamps against the wall clock.
+            rt_kwargs = dict(kwargs)
+            rt_kwargs["parameter_overrides"] = [
+                *(kwargs.get("parameter_overrides") or []),
+                Parameter("use_sim_time", value=self.get_parameter("use_sim_time").value),
+            ]
+            self.rt_io_node = Node("_system_node_rt", namespace=namespace, **rt_kwargs)
+            self.add_post_set_parameters_callback(self._share_sim_time)
+            self.system.rt_node = self.rt_io_node  # plugins' RT-side subscriptions (odometry)
+            # One /clock subscription for the eight nodes instead of eight: sensors_node's (the RT
+            # loop serves it; the ROS graph check sees an EasyNav node waiting for /clock).
+            self.shared_clock = SharedClockSubscription(
+                self.sensors_node, [*self.all_nodes(), self.rt_io_node]
+            )
         # The buffer is shared by everything in this process under this namespace: transforms
         # left by an earlier system (a runtime stopped and started again, the next test) are
         # on another run's time line and would shadow this run's for the cache window.

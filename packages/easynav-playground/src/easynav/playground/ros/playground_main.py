@@ -104,6 +104,8 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(
         args=["easynav-playground", *ros_args], signal_handler_options=SignalHandlerOptions.NO
     )
+    # The handler runs in the main thread and takes the event's lock: safe only because this
+    # thread never holds it (it polls is_set, never waits on the event).
     previous = {
         sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)
     }

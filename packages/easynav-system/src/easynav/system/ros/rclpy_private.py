@@ -53,42 +53,46 @@ def lifecycle_state_label(node: LifecycleNode) -> str:
     return node._state_machine.current_state[1]
 
 
-#: Threads in :func:`clock_subscriptions_deferred`, and rclpy's own subscribing method.
-_deferring_threads: set[int] = set()
+#: How deep the calling thread is in :func:`clock_subscriptions_deferred` blocks.
+_deferral = threading.local()
 _rclpy_subscribe_to_clock_topic = TimeSource._subscribe_to_clock_topic
 
 
 def _subscribe_unless_deferred(source: TimeSource) -> None:
-    if threading.get_ident() in _deferring_threads:
+    if getattr(_deferral, "depth", 0) > 0:
         return  # left to take_over_clock_subscription's caller
     _rclpy_subscribe_to_clock_topic(source)
+
+
+# Installed once, when EasyNav's system is imported: it defers only inside the blocks below,
+# and every other call goes to rclpy's own method.
+TimeSource._subscribe_to_clock_topic = _subscribe_unless_deferred
 
 
 @contextmanager
 def clock_subscriptions_deferred() -> Iterator[None]:
     """Nodes constructed in this block by this thread do not subscribe to ``/clock`` (on
-    ``use_sim_time``): :func:`take_over_clock_subscription` then has none to destroy.
+    ``use_sim_time``): :func:`take_over_clock_subscription` then has none to destroy. Each such
+    node must be taken over: on simulated time it has no subscription of its own, and its
+    clock would stay at zero. Blocks nest.
 
-    Why: a participant whose eight ``/clock`` subscriptions were created and destroyed at once
-    (each node's own, replaced by the shared one) was missing, for another participant, every
-    subscription it had afterwards (``/clock``, ``tf``...) for as long as it was watched:
-    measured with rclpy alone (Fast DDS 2.14, two participants in one process), 4 starts in
-    100 with the churn, 0 in 150 without it. A system started that way never received the
-    simulator's clock or transforms.
+    Why: it works around a discovery fault whose cause is not known (Fast DDS 2.14 under rclpy):
+    a participant whose eight ``/clock`` subscriptions were created and destroyed at once (each
+    node's own, replaced by the shared one) was missing, for another participant, every
+    subscription it had afterwards (``/clock``, ``tf``...) for as long as it was watched.
+    Measured with rclpy alone, two participants in one process: 9 starts in 250 with the churn,
+    0 in 300 without it. A system started that way never received the simulator's clock or
+    transforms. Other creations and destructions at a participant's start may trigger it too.
 
     Why private: rclpy subscribes in ``Node.__init__`` (``TimeSource._subscribe_to_clock_topic``,
-    run when ``use_sim_time`` is true), before any caller could intervene. That method is
-    replaced once, for good, by one that defers only for the threads inside this block; every
-    other thread's nodes subscribe as rclpy does. Thread contract: any thread; the block
-    affects the calling thread only.
+    run when ``use_sim_time`` is true), before any caller could intervene; that method is
+    replaced (see above). Thread contract: any thread; a block affects the calling thread only.
     """
-    TimeSource._subscribe_to_clock_topic = _subscribe_unless_deferred
-    ident = threading.get_ident()
-    _deferring_threads.add(ident)
+    _deferral.depth = getattr(_deferral, "depth", 0) + 1
     try:
         yield
     finally:
-        _deferring_threads.discard(ident)
+        _deferral.depth -= 1
 
 
 def take_over_clock_subscription(node: Node, subscribe: Callable[[], None]) -> TimeSource:
