@@ -23,7 +23,7 @@ class SharedClockSubscription:
     source whose node is on simulated time, exactly as its own subscription did
     (``TimeSource.clock_callback``). The subscription is created when the first node is on
     simulated time (same QoS as rclpy's: depth 1, best effort). Nodes constructed inside
-    ``clock_subscriptions_deferred()`` (the runtime constructs them so) never had their own;
+    ``clock_subscriptions_deferred()`` (SystemNode constructs its nodes so) never had their own;
     others have theirs destroyed here.
 
     Thread contract: construct before the executors spin (the nodes' constructors have run);
