@@ -266,10 +266,41 @@ def test_vectorised_scores_match_the_per_particle_loop():
     rot = attitudes(yaws, normals)
     trans = np.column_stack((3.0 + rng.normal(0, 0.2, 6), 2.0 + rng.normal(0, 0.2, 6),
                              np.zeros(6)))
-    fast = score_particles(inflated, rot, trans, points, origins, chunk=4)
+    fast = score_particles(inflated, rot, trans, points, origins, chunk=4, compiled=False)
     slow = score_reference(inflated, rot, trans, points, origins)
     np.testing.assert_allclose(fast, slow)
     assert fast[0] > 0
+
+
+def test_compiled_scores_match_the_vectorised_ones():
+    from easynav.localizers.navmap_voxel_scoring import _compiled_scoring
+
+    if _compiled_scoring() is None:
+        pytest.skip("numba not installed")
+    # Particles over the whole room and beyond it (rays leaving the box), tilted ones, sensors
+    # off the footprint's origin: occluded and visible points, in and out of the map.
+    inflated = InflatedVoxelMap(VOXELS, 0.1, 0.01)
+    rng = np.random.default_rng(3)
+    points = ray_cast(VOXELS, (3.0, 2.0, 0.3), 0.0, rng)[::3] + (0.0, 0.0, 0.3)
+    origins = np.tile((0.1, -0.05, 0.3), (len(points), 1))
+    n = 200
+    yaws = rng.uniform(-math.pi, math.pi, n)
+    normals = rng.normal((0.0, 0.0, 1.0), 0.2, (n, 3))
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    rot = attitudes(yaws, normals)
+    trans = np.column_stack((rng.uniform(-2.0, 12.0, n), rng.uniform(-2.0, 8.0, n),
+                             rng.uniform(-0.5, 2.0, n)))
+    compiled = score_particles(inflated, rot, trans, points, origins)
+    vectorised = score_particles(inflated, rot, trans, points, origins, compiled=False)
+    np.testing.assert_allclose(compiled, vectorised, rtol=1e-12, atol=1e-9)
+    assert (compiled > 0).sum() > n // 2
+    # Occlusion decided some of them: without it the sums would be larger.
+    unoccluded = InflatedVoxelMap(VOXELS, 0.1, 0.01)
+    unoccluded.tail_skip = 10**6
+    assert (score_particles(unoccluded, rot, trans, points, origins) > compiled).any()
+    # An empty map scores nothing, compiled or not.
+    empty = InflatedVoxelMap(BonxaiMap(RES), 0.1, 0.01)
+    assert score_particles(empty, rot, trans, points, origins).tolist() == [0.0] * n
 
 
 # -- the surface -------------------------------------------------------------------------------

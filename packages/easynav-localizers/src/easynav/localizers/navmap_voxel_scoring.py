@@ -11,9 +11,10 @@ easynav_navmap_localizer does: particles predicted on the NavMap, corrected on `
 - :func:`score_particles`: for every particle × point, the inflated probability at the point's
   end voxel, zeroed when the probability is at least :data:`RAY_CHECK_MIN_PROBABILITY` and the
   ray from the sensor's voxel to the end voxel crosses an occupied voxel before the last
-  ``tail_skip`` voxels (the original's rule). Vectorised with numpy over particles × points;
-  the ray walk is the original's integer 3D DDA in closed form (:func:`rays_occluded`), so it
-  vectorises over rays and steps too.
+  ``tail_skip`` voxels (the original's rule). The ray walk is the original's integer 3D DDA in
+  closed form (:func:`rays_occluded`). Compiled with numba when installed (one loop, each ray
+  walked until its first occupied voxel); else vectorised with numpy over particles × points
+  and over rays and steps, the compiled loop's reference.
 - :func:`ray_occluded_reference` and :func:`score_reference`: the original's loops, one ray and
   one particle at a time, the readable references of the tests.
 
@@ -245,22 +246,58 @@ def score_particles(
     points: np.ndarray,
     origins: np.ndarray,
     chunk: int = 32,
+    compiled: bool = True,
 ) -> np.ndarray:
     """Sum of the point scores (:func:`point_scores`) of each particle: ``rotations`` ``(N, 3,
     3)`` and ``translations`` ``(N, 3)`` place the robot footprint frame in the map; ``points``
     ``(M, 3)`` are in the footprint frame, ``origins`` ``(M, 3)`` the position of the sensor
-    that measured each point (footprint frame). Vectorised over ``chunk`` particles × all
-    points at a time."""
+    that measured each point (footprint frame).
+
+    With numba installed (and ``compiled``) one compiled loop (``_voxel_scoring_numba``) whose
+    ray walks stop at the first occupied voxel; otherwise vectorised over ``chunk`` particles ×
+    all points at a time, every voxel of every checked ray looked up (this numpy version is the
+    compiled one's reference, ``compiled=False``)."""
     n = len(rotations)
     sums = np.zeros(n)
     if n == 0 or len(points) == 0:
         return sums
+    kernel = _compiled_scoring() if compiled else None
+    if kernel is not None:
+        return kernel(
+            np.ascontiguousarray(rotations, dtype=np.float64),
+            np.ascontiguousarray(translations, dtype=np.float64),
+            np.ascontiguousarray(points, dtype=np.float64),
+            np.ascontiguousarray(origins, dtype=np.float64),
+            inflated.codes,
+            inflated.origin,
+            inflated.resolution,
+            int(inflated.tail_skip),
+        )
     for a in range(0, n, chunk):
         rot, trans = rotations[a : a + chunk], translations[a : a + chunk]
         ends = np.einsum("nij,mj->nmi", rot, points) + trans[:, None, :]
         starts = np.einsum("nij,mj->nmi", rot, origins) + trans[:, None, :]
         sums[a : a + chunk] = point_scores(inflated, starts, ends).sum(axis=1)
     return sums
+
+
+_SCORING = None
+
+
+def _compiled_scoring():
+    """The numba scoring kernel, compiled (or loaded from numba's cache) on first use; None
+    without numba."""
+    global _SCORING
+    if _SCORING is None:
+        try:
+            from easynav.common.compiled_kernels import compile_in_child
+            from easynav.localizers._voxel_scoring_numba import score_kernel
+        except ImportError:
+            _SCORING = False
+        else:
+            _SCORING = compile_in_child(
+                score_kernel, "easynav.localizers._voxel_scoring_numba:score_kernel")
+    return _SCORING or None
 
 
 def score_reference(inflated: InflatedVoxelMap, rotations, translations, points,
