@@ -9,11 +9,11 @@ lidar scan ray-cast on the upper floor, particles around the robot. Measured:
 - ``NavMapAMCLLocalizer.update``: the whole correction (per-sensor downsampling, TF, scoring
   with ray occlusion on the inflated map, weights, estimate, NavState) for 100 and 500 particles;
 - ``update_rt``: the prediction (motion along the surface, NavMap point location);
-- the scoring alone: compiled (:func:`score_particles` with numba) beside its numpy version
-  (vectorised over particles, points and ray steps), 300 particles × 120 points on the map at
-  0.05 m (the playground's size, where the numpy version took about half a second a
-  correction on the campus world); the numpy version beside :func:`score_reference` (the
-  original's loop, one particle, one point and one ray step at a time), 20 particles.
+- the scoring alone (inflation σ 0.05 m): compiled (:func:`score_particles` with numba) beside
+  its numpy version (vectorised over particles, points and ray steps), 300 particles × 120
+  points (the integration matrix's NavMap AMCL settings); the numpy version beside
+  :func:`score_reference` (the original's loop, one particle, one point and one ray step at a
+  time), 20 particles.
 
 Goals: a correction of the default 100 particles within a 10 Hz non-RT cycle (<= 100 ms), a
 prediction of 100 particles <= 2 ms, and the compiled scoring at least 5× faster than the numpy

@@ -278,8 +278,10 @@ def test_compiled_scores_match_the_vectorised_ones():
     if _compiled_scoring() is None:
         pytest.skip("numba not installed")
     # Particles over the whole room and beyond it (rays leaving the box), tilted ones, sensors
-    # off the footprint's origin: occluded and visible points, in and out of the map.
-    inflated = InflatedVoxelMap(VOXELS, 0.1, 0.01)
+    # off the footprint's origin: occluded and visible points, in and out of the map. σ 0.15 m
+    # on 0.1 m voxels puts probabilities on both sides of the ray check's 0.4 (0.41, 0.33).
+    inflated = InflatedVoxelMap(VOXELS, 0.15, 0.01)
+    assert {104, 84} <= set(np.unique(inflated.codes).tolist())
     rng = np.random.default_rng(3)
     points = ray_cast(VOXELS, (3.0, 2.0, 0.3), 0.0, rng)[::3] + (0.0, 0.0, 0.3)
     origins = np.tile((0.1, -0.05, 0.3), (len(points), 1))
@@ -295,12 +297,37 @@ def test_compiled_scores_match_the_vectorised_ones():
     np.testing.assert_allclose(compiled, vectorised, rtol=1e-12, atol=1e-9)
     assert (compiled > 0).sum() > n // 2
     # Occlusion decided some of them: without it the sums would be larger.
-    unoccluded = InflatedVoxelMap(VOXELS, 0.1, 0.01)
+    unoccluded = InflatedVoxelMap(VOXELS, 0.15, 0.01)
     unoccluded.tail_skip = 10**6
     assert (score_particles(unoccluded, rot, trans, points, origins) > compiled).any()
-    # An empty map scores nothing, compiled or not.
+    # An empty map scores nothing; a particle or a point that is not finite scores 0.
     empty = InflatedVoxelMap(BonxaiMap(RES), 0.1, 0.01)
-    assert score_particles(empty, rot, trans, points, origins).tolist() == [0.0] * n
+    for fast in (True, False):
+        assert score_particles(empty, rot, trans, points, origins,
+                               compiled=fast).tolist() == [0.0] * n
+    trans[:3] = ((np.nan, 2.0, 0.0), (3.0, np.inf, 0.0), (3.0, 2.0, -np.inf))
+    assert score_particles(inflated, rot, trans, points, origins)[:3].tolist() == [0.0] * 3
+    points[:] = np.nan
+    assert score_particles(inflated, rot, trans, points, origins).tolist() == [0.0] * n
+
+
+def test_compiled_scoring_checks_shapes_and_broadcasts_one_origin():
+    from easynav.localizers.navmap_voxel_scoring import _compiled_scoring
+
+    if _compiled_scoring() is None:
+        pytest.skip("numba not installed")
+    inflated = InflatedVoxelMap(VOXELS, 0.1, 0.01)
+    rot = attitudes(np.zeros(2), np.tile((0.0, 0.0, 1.0), (2, 1)))
+    trans = np.array([[3.0, 2.0, 0.0], [3.1, 2.0, 0.0]])
+    points = ray_cast(VOXELS, (3.0, 2.0, 0.3), 0.0, np.random.default_rng(4))[::5]
+    one = score_particles(inflated, rot, trans, points, np.array([[0.0, 0.0, 0.3]]))
+    every = score_particles(inflated, rot, trans, points, np.tile((0.0, 0.0, 0.3),
+                                                                  (len(points), 1)))
+    assert one.tolist() == every.tolist()
+    with pytest.raises(ValueError, match=r"points must be \(M, 3\)"):
+        score_particles(inflated, rot, trans, points[:, :2], points[:, :2])
+    with pytest.raises(ValueError, match="translations"):
+        score_particles(inflated, rot, trans[:1], points, points)
 
 
 # -- the surface -------------------------------------------------------------------------------

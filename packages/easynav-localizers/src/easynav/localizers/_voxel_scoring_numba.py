@@ -19,10 +19,9 @@ import math
 import numpy as np
 from numba import njit
 
-#: Code of a voxel occupied in the source map (``navmap_voxel_scoring.OCCUPIED``).
-_OCCUPIED = 255
-#: ``navmap_voxel_scoring.RAY_CHECK_MIN_PROBABILITY``.
-_RAY_CHECK_MIN_PROBABILITY = 0.4
+#: Cell coordinates beyond this (in voxels) are off any map: such a point (or a non-finite one,
+#: whose conversion to an integer has no defined value) scores 0.
+_FAR = 1e15
 
 
 @njit(cache=True, nogil=True)
@@ -36,9 +35,10 @@ def _code_at(codes, x, y, z):
 
 
 @njit(cache=True, nogil=True)
-def _occluded(codes, ax, ay, az, bx, by, bz, skip):
-    """Whether an occupied voxel lies on the ray from box-relative voxel ``a`` to ``b`` before
-    its last ``skip`` voxels (``navmap_voxel_scoring.rays_occluded`` for one ray)."""
+def _occluded(codes, occupied, ax, ay, az, bx, by, bz, skip):
+    """Whether a voxel of code ``occupied`` lies on the ray from box-relative voxel ``a`` to
+    ``b`` before its last ``skip`` voxels (``navmap_voxel_scoring.rays_occluded`` for one
+    ray)."""
     dx, dy, dz = abs(bx - ax), abs(by - ay), abs(bz - az)
     sx = 1 if bx >= ax else -1
     sy = 1 if by >= ay else -1
@@ -49,44 +49,60 @@ def _occluded(codes, ax, ay, az, bx, by, bz, skip):
         x = ax + sx * ((half + k * dx) // n)
         y = ay + sy * ((half + k * dy) // n)
         z = az + sz * ((half + k * dz) // n)
-        if _code_at(codes, x, y, z) == _OCCUPIED:
+        if _code_at(codes, x, y, z) == occupied:
             return True
     return False
 
 
 @njit(cache=True, nogil=True)
+def _cells(r, tx, ty, tz, x, y, z, resolution):
+    """The voxel (float cell coordinates, floored) of point ``(x, y, z)`` moved by rotation
+    ``r`` and translation ``t``; the same operations, in the same order, as the numpy
+    version's ``einsum`` and ``cells_of``."""
+    return (math.floor((r[0, 0] * x + r[0, 1] * y + r[0, 2] * z + tx) / resolution),
+            math.floor((r[1, 0] * x + r[1, 1] * y + r[1, 2] * z + ty) / resolution),
+            math.floor((r[2, 0] * x + r[2, 1] * y + r[2, 2] * z + tz) / resolution))
+
+
+@njit(cache=True, nogil=True)
+def _on_a_map(cx, cy, cz):
+    """Whether float cell coordinates can be made integers (finite, not absurdly far)."""
+    return abs(cx) < _FAR and abs(cy) < _FAR and abs(cz) < _FAR
+
+
+@njit(cache=True, nogil=True)
 def score_kernel(rotations, translations, points, origins, codes, box_origin, resolution,
-                 skip):
-    """Per-particle sums as :func:`score_particles` returns them; ``codes`` and ``box_origin``
-    are the inflated map's, ``skip`` its ``tail_skip``."""
+                 skip, occupied, ray_check_min_probability):
+    """Per-particle sums as :func:`score_particles` returns them; ``codes``, ``box_origin``
+    and ``skip`` are the inflated map's (``codes``, ``origin``, ``tail_skip``), ``occupied``
+    and ``ray_check_min_probability`` ``navmap_voxel_scoring``'s ``OCCUPIED`` and
+    ``RAY_CHECK_MIN_PROBABILITY``. Shapes are the caller's to check: ``(N, 3, 3)``,
+    ``(N, 3)``, ``(M, 3)``, ``(M, 3)``."""
     n = rotations.shape[0]
     m = points.shape[0]
+    ox0, oy0, oz0 = box_origin[0], box_origin[1], box_origin[2]
     sums = np.zeros(n)
     for i in range(n):
         r = rotations[i]
         tx, ty, tz = translations[i, 0], translations[i, 1], translations[i, 2]
         total = 0.0
         for j in range(m):
-            px, py, pz = points[j, 0], points[j, 1], points[j, 2]
-            bx = int(math.floor((r[0, 0] * px + r[0, 1] * py + r[0, 2] * pz + tx)
-                                / resolution)) - box_origin[0]
-            by = int(math.floor((r[1, 0] * px + r[1, 1] * py + r[1, 2] * pz + ty)
-                                / resolution)) - box_origin[1]
-            bz = int(math.floor((r[2, 0] * px + r[2, 1] * py + r[2, 2] * pz + tz)
-                                / resolution)) - box_origin[2]
+            ex, ey, ez = _cells(r, tx, ty, tz, points[j, 0], points[j, 1], points[j, 2],
+                                resolution)
+            if not _on_a_map(ex, ey, ez):
+                continue
+            bx, by, bz = int(ex) - ox0, int(ey) - oy0, int(ez) - oz0
             code = _code_at(codes, bx, by, bz)
             if code == 0:
                 continue
-            p = 1.0 if code == _OCCUPIED else code / 254.0
-            if p >= _RAY_CHECK_MIN_PROBABILITY:
-                ox, oy, oz = origins[j, 0], origins[j, 1], origins[j, 2]
-                ax = int(math.floor((r[0, 0] * ox + r[0, 1] * oy + r[0, 2] * oz + tx)
-                                    / resolution)) - box_origin[0]
-                ay = int(math.floor((r[1, 0] * ox + r[1, 1] * oy + r[1, 2] * oz + ty)
-                                    / resolution)) - box_origin[1]
-                az = int(math.floor((r[2, 0] * ox + r[2, 1] * oy + r[2, 2] * oz + tz)
-                                    / resolution)) - box_origin[2]
-                if _occluded(codes, ax, ay, az, bx, by, bz, skip):
+            p = 1.0 if code == occupied else code / 254.0
+            if p >= ray_check_min_probability:
+                sx, sy, sz = _cells(r, tx, ty, tz, origins[j, 0], origins[j, 1], origins[j, 2],
+                                    resolution)
+                if not _on_a_map(sx, sy, sz):
+                    continue
+                if _occluded(codes, occupied, int(sx) - ox0, int(sy) - oy0, int(sz) - oz0,
+                             bx, by, bz, skip):
                     continue
             total += p
         sums[i] = total

@@ -263,15 +263,25 @@ def score_particles(
         return sums
     kernel = _compiled_scoring() if compiled else None
     if kernel is not None:
+        # The compiled loop indexes without bounds checks: shapes are checked here, and
+        # origins broadcast as the numpy version broadcasts them.
+        points = np.asarray(points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3:
+            raise ValueError(f"points must be (M, 3), got {points.shape}")
+        if np.shape(rotations) != (n, 3, 3) or np.shape(translations) != (n, 3):
+            raise ValueError(f"rotations {np.shape(rotations)} and translations "
+                             f"{np.shape(translations)} must be ({n}, 3, 3) and ({n}, 3)")
         return kernel(
             np.ascontiguousarray(rotations, dtype=np.float64),
             np.ascontiguousarray(translations, dtype=np.float64),
-            np.ascontiguousarray(points, dtype=np.float64),
-            np.ascontiguousarray(origins, dtype=np.float64),
+            np.ascontiguousarray(points),
+            np.ascontiguousarray(np.broadcast_to(origins, points.shape), dtype=np.float64),
             inflated.codes,
             inflated.origin,
             inflated.resolution,
             int(inflated.tail_skip),
+            OCCUPIED,
+            RAY_CHECK_MIN_PROBABILITY,
         )
     for a in range(0, n, chunk):
         rot, trans = rotations[a : a + chunk], translations[a : a + chunk]
