@@ -269,9 +269,9 @@ def test_bad_parameters_fail_configuration(params, message):
 
 
 def test_compiled_scoring_agrees_with_the_numpy_reference():
-    from easynav.localizers.particle_filter import _compiled_scoring, hit_fractions
+    from easynav.localizers.particle_filter import COMPILED_SCORING, hit_fractions
 
-    if _compiled_scoring() is None:
+    if not COMPILED_SCORING.available():
         pytest.skip("numba not installed")
     costmap = house_costmap()
     rng = np.random.default_rng(5)

@@ -273,9 +273,9 @@ def test_vectorised_scores_match_the_per_particle_loop():
 
 
 def test_compiled_scores_match_the_vectorised_ones():
-    from easynav.localizers.navmap_voxel_scoring import _compiled_scoring
+    from easynav.localizers.navmap_voxel_scoring import COMPILED_SCORING
 
-    if _compiled_scoring() is None:
+    if not COMPILED_SCORING.available():
         pytest.skip("numba not installed")
     # Particles over the whole room and beyond it (rays leaving the box), tilted ones, sensors
     # off the footprint's origin: occluded and visible points, in and out of the map. σ 0.15 m
@@ -312,9 +312,9 @@ def test_compiled_scores_match_the_vectorised_ones():
 
 
 def test_compiled_scoring_checks_shapes_and_broadcasts_one_origin():
-    from easynav.localizers.navmap_voxel_scoring import _compiled_scoring
+    from easynav.localizers.navmap_voxel_scoring import COMPILED_SCORING
 
-    if _compiled_scoring() is None:
+    if not COMPILED_SCORING.available():
         pytest.skip("numba not installed")
     inflated = InflatedVoxelMap(VOXELS, 0.1, 0.01)
     rot = attitudes(np.zeros(2), np.tile((0.0, 0.0, 1.0), (2, 1)))

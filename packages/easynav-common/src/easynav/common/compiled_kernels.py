@@ -81,6 +81,37 @@ def compile_in_child(dispatcher, locator: str):
     return dispatcher
 
 
+class CompiledKernel:
+    """The numba kernel ``name`` of the module ``module`` (an ``njit(cache=True)`` dispatcher,
+    hooked by :func:`compile_in_child`), imported (and so compiled or loaded from numba's
+    cache) the first time it is asked for.
+
+    ``get()`` is None when the module cannot be imported (numba is not installed: the caller
+    runs its numpy or pure-Python reference instead). Thread contract: any thread; at worst two
+    threads import the module at once, which Python's import lock makes safe. Exceptions: an
+    ImportError of the kernel's module is the answer None, nothing else is caught.
+    """
+
+    def __init__(self, module: str, name: str) -> None:
+        self.module = module
+        self.name = name
+        self._kernel = None  # None: not tried yet; False: unavailable
+
+    def get(self):
+        """The kernel, or None without numba."""
+        if self._kernel is None:
+            try:
+                kernel = getattr(importlib.import_module(self.module), self.name)
+                self._kernel = compile_in_child(kernel, f"{self.module}:{self.name}")
+            except ImportError:
+                self._kernel = False
+        return self._kernel or None
+
+    def available(self) -> bool:
+        """Whether the compiled kernel can be used."""
+        return self.get() is not None
+
+
 def _load_from_cache(dispatcher, signature: tuple) -> bool:
     """Load ``signature``'s compiled version from numba's cache into ``dispatcher`` (as numba's
     ``Dispatcher.compile`` does first); False when the cache does not hold it."""

@@ -33,6 +33,7 @@ import math
 
 import numpy as np
 
+from easynav.common.compiled_kernels import CompiledKernel
 from easynav.maps.voxel.bonxai_map import BonxaiMap
 from easynav.maps.voxel.voxel_rays import unpack_keys
 
@@ -261,7 +262,7 @@ def score_particles(
     sums = np.zeros(n)
     if n == 0 or len(points) == 0:
         return sums
-    kernel = _compiled_scoring() if compiled else None
+    kernel = COMPILED_SCORING.get() if compiled else None
     if kernel is not None:
         # The compiled loop indexes without bounds checks: shapes are checked here, and
         # origins broadcast as the numpy version broadcasts them.
@@ -291,23 +292,8 @@ def score_particles(
     return sums
 
 
-_SCORING = None
-
-
-def _compiled_scoring():
-    """The numba scoring kernel, compiled (or loaded from numba's cache) on first use; None
-    without numba."""
-    global _SCORING
-    if _SCORING is None:
-        try:
-            from easynav.common.compiled_kernels import compile_in_child
-            from easynav.localizers._voxel_scoring_numba import score_kernel
-        except ImportError:
-            _SCORING = False
-        else:
-            _SCORING = compile_in_child(
-                score_kernel, "easynav.localizers._voxel_scoring_numba:score_kernel")
-    return _SCORING or None
+#: The compiled scoring (:func:`score_particles`), None from ``get()`` without numba.
+COMPILED_SCORING = CompiledKernel("easynav.localizers._voxel_scoring_numba", "score_kernel")
 
 
 def score_reference(inflated: InflatedVoxelMap, rotations, translations, points,

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from easynav.common.compiled_kernels import CompiledKernel
+
 #: Cost of a lethal cell in a Costmap2D: the cells a laser point hits (the original's 254).
 LETHAL = 254
 
@@ -122,7 +124,7 @@ def hit_fractions(
         raise ValueError(
             f"likelihood field shape {field.shape} != map shape {(grid.height, grid.width)}"
         )
-    kernel = _compiled_scoring() if compiled else None
+    kernel = COMPILED_SCORING.get() if compiled else None
     if kernel is not None:
         return kernel(
             np.ascontiguousarray(poses, dtype=np.float64),
@@ -167,22 +169,8 @@ def compiled_scoring_pays(particles: int, points: int) -> bool:
     return particles * points >= COMPILED_SCORING_MIN_PAIRS
 
 
-_SCORING = None
-
-
-def _compiled_scoring():
-    """The numba scoring kernel, compiled on first use (None without numba)."""
-    global _SCORING
-    if _SCORING is None:
-        try:
-            from easynav.common.compiled_kernels import compile_in_child
-            from easynav.localizers._scoring_numba import score_kernel
-        except ImportError:
-            _SCORING = False
-        else:
-            _SCORING = compile_in_child(
-                score_kernel, "easynav.localizers._scoring_numba:score_kernel")
-    return _SCORING or None
+#: The compiled scoring of :func:`hit_fractions`, None from ``get()`` without numba.
+COMPILED_SCORING = CompiledKernel("easynav.localizers._scoring_numba", "score_kernel")
 
 
 #: Cell size (m) of :func:`place_clusters`: Nav2's AMCL clusters its particles on 0.5 m cells.

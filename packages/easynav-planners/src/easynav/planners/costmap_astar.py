@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from easynav.planners.compiled_kernel import CompiledKernel
+from easynav.common.compiled_kernels import CompiledKernel
 
 #: First blocked cost (INSCRIBED_INFLATED_OBSTACLE): cells at or above it are never entered.
 BLOCKED_COST = 253

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from easynav.planners.compiled_kernel import CompiledKernel
+from easynav.common.compiled_kernels import CompiledKernel
 
 #: The original's normalisation of a cost (INSCRIBED_INFLATED_OBSTACLE).
 INSCRIBED = 253.0

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from easynav.planners.compiled_kernel import CompiledKernel
+from easynav.common.compiled_kernels import CompiledKernel
 
 #: How far (in the line's parameter, 0 at p, 1 at q) the line may leave the target NavCel
 #: before q: rounding, for a q on the target's edge or vertex.
