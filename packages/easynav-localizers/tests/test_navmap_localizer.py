@@ -309,6 +309,11 @@ def test_compiled_scores_match_the_vectorised_ones():
     assert score_particles(inflated, rot, trans, points, origins)[:3].tolist() == [0.0] * 3
     points[:] = np.nan
     assert score_particles(inflated, rot, trans, points, origins).tolist() == [0.0] * n
+    # The guard looks at the coordinates before flooring them (numba's floor of a NaN is an
+    # arbitrary int64, which could land in the map on another machine).
+    from easynav.localizers._voxel_scoring_numba import _on_a_map
+
+    assert not _on_a_map(math.nan, 0.0, 0.0) and not _on_a_map(0.0, 0.0, -math.inf)
 
 
 def test_compiled_scoring_checks_shapes_and_broadcasts_one_origin():
