@@ -309,11 +309,15 @@ def test_compiled_scores_match_the_vectorised_ones():
     assert score_particles(inflated, rot, trans, points, origins)[:3].tolist() == [0.0] * 3
     points[:] = np.nan
     assert score_particles(inflated, rot, trans, points, origins).tolist() == [0.0] * n
-    # The guard looks at the coordinates before flooring them (numba's floor of a NaN is an
-    # arbitrary int64, which could land in the map on another machine).
-    from easynav.localizers._voxel_scoring_numba import _on_a_map
+    # The guard looks at the coordinates before flooring them: numba's floor of a NaN is an
+    # arbitrary int64 (INT64_MIN on x86-64), which a box starting there would take for its first
+    # voxel, occupied here.
+    from easynav.localizers._voxel_scoring_numba import score_kernel
 
-    assert not _on_a_map(math.nan, 0.0, 0.0) and not _on_a_map(0.0, 0.0, -math.inf)
+    lowest = np.iinfo(np.int64).min
+    sums = score_kernel(rot[:2], np.full((2, 3), np.nan), np.zeros((4, 3)), np.full((4, 3), np.nan),
+                        np.full((1, 1, 1), 255, np.uint8), np.full(3, lowest), 0.1, 0, 255, 0.4)
+    assert sums.tolist() == [0.0, 0.0]
 
 
 def test_compiled_scoring_checks_shapes_and_broadcasts_one_origin():

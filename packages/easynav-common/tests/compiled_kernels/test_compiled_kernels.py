@@ -90,6 +90,20 @@ def test_a_kernel_without_a_disk_cache_is_left_as_it_is():
     assert "_compile_for_args" not in vars(dispatcher)
 
 
+def test_a_compiled_kernel_is_loaded_once_and_is_none_without_its_module(monkeypatch):
+    import numpy as np
+
+    from easynav.common.compiled_kernels import CompiledKernel
+
+    missing = CompiledKernel("easynav_no_such_kernel_module", "kernel")
+    assert missing.get() is None and not missing.available()
+    monkeypatch.syspath_prepend(str(Path(__file__).parent))
+    present = CompiledKernel("sample_kernel", "weighted_sum")
+    kernel = present.get()
+    assert kernel is present.get() and present.available()
+    assert kernel(np.ones(3), 2.0) == 6.0
+
+
 FROM_A_REALTIME_THREAD = """
 import os, sys, threading
 import numpy as np
