@@ -199,6 +199,7 @@ class CollisionModel:
         self.costmap = costmap
         self.unknown_is_obstacle = unknown_is_obstacle
         radius = max(radius, 0.0)
+        self.radius = radius  # the inscribed radius of the CostCritic's local inflation
         keep = radius + max(margin, 0.0)
         self.field: ClearanceField | None = None
         self.threshold = 0.0

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import numpy as np
 
 from easynav.controllers.mppi.collision_model import CollisionModel, rollout_costs
 from easynav.controllers.mppi.critic import Critic
+from easynav.controllers.mppi.local_inflation import LocalInflation, has_inflation
 from easynav.controllers.mppi.mppi_batch import MppiBatch
 from easynav.core.plugins import Param
 from easynav.core.types import LETHAL_OBSTACLE
@@ -23,6 +27,12 @@ class CostCritic(Critic):
     Otherwise ``(cost_weight · Σ (cost / 254) / points)^cost_power``, except within
     ``near_goal_distance`` of the goal (a goal near a wall stays reachable). No costmap in
     NavState: no term.
+
+    A costmap without inflation (no cell between free and inscribed: a SimpleMap or a GridMap
+    read as a costmap, a costmap with no inflation filter) is inflated near the robot with
+    ``inflation_radius`` and ``cost_scaling_factor`` (:class:`LocalInflation`; the inscribed
+    radius is ``robot_geometry.radius``): without the graded costs the path critics pull the
+    robot across the corners of obstacles up to the collision margin.
     """
 
     NAME = "CostCritic"
@@ -36,7 +46,17 @@ class CostCritic(Critic):
         Param("collision_margin", 0.05,
               "clearance kept between the robot's disc (robot_geometry.radius) and obstacle "
               "cells, for the localisation and tracking errors (beyond Nav2)", "m", ge=0.0),
+        Param("inflation_radius", 0.7,
+              "for a costmap without inflation: the radius of the inflation computed near the "
+              "robot (0: none; beyond Nav2)", "m", ge=0.0),
+        Param("cost_scaling_factor", 3.0,
+              "for a costmap without inflation: the decay rate of that inflation's cost "
+              "(beyond Nav2)", "1/m", ge=0.0),
     )
+
+    def __init__(self, values: Mapping[str, Any]) -> None:
+        super().__init__(values)
+        self._checked: tuple[object, bool] = (None, False)  # (costmap, has_inflation)
 
     def score(self, batch: MppiBatch) -> None:
         if not self.param("enabled") or batch.costmap is None:
@@ -51,12 +71,27 @@ class CostCritic(Critic):
         batch.costs += np.float32(self.param("collision_cost")) * collided
         if batch.remaining < self.param("near_goal_distance"):
             return
+        if self.param("inflation_radius") > 0.0 and not self._inflated(batch.costmap):
+            x0, y0 = np.float32(batch.pose[0]), np.float32(batch.pose[1])
+            half_size = float(max(np.abs(x - x0).max(), np.abs(y - y0).max()))
+            local = LocalInflation(batch.costmap, batch.pose[0], batch.pose[1],
+                                   half_size + batch.costmap.resolution,
+                                   self.param("inflation_radius"), collision.radius,
+                                   self.param("cost_scaling_factor"))
+            costs = np.maximum(costs, local.at(x, y))
         graded = np.where(lethal, 0, costs).sum(axis=1, dtype=np.float32)
         # Costs normalised to [0, 1] (÷ 254, as Nav2) so the weight is comparable with the
         # other critics' (metres, radians).
         term = self.param("cost_weight") * graded / np.float32(costs.shape[1] * LETHAL_OBSTACLE)
         power = self.param("cost_power")
         batch.costs += term if power == 1 else term**power
+
+    def _inflated(self, costmap) -> bool:
+        """Whether ``costmap`` has an inflation filter's graded costs (checked once per map
+        object: the maps managers write a new one when it changes)."""
+        if self._checked[0] is not costmap:
+            self._checked = (costmap, has_inflation(costmap))
+        return self._checked[1]
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:  # pragma: no cover - score()
         """Not used: this critic adds its two terms (collision, graded cost) in :meth:`score`."""
