@@ -32,7 +32,8 @@ from easynav.core.types import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Cos
 def inflation_cost_table(cell_radius: int, resolution: float, inscribed_radius: float,
                          cost_scaling_factor: float) -> np.ndarray:
     """Costs (uint8) indexed by the squared distance in cells, ``0 … cell_radius² + 1``; the
-    last entry, 0, stands for every distance beyond the radius."""
+    last entry, 0, stands for every distance beyond the radius. The costmap filter's table
+    (easynav-maps, which this distribution does not depend on), tested equal to it."""
     squared = np.arange(cell_radius * cell_radius + 2, dtype=np.float64)
     metres = np.sqrt(squared) * resolution
     graded = (INSCRIBED_INFLATED_OBSTACLE - 1) * np.exp(
@@ -44,11 +45,31 @@ def inflation_cost_table(cell_radius: int, resolution: float, inscribed_radius: 
     return table
 
 
-def has_inflation(costmap: Costmap2D) -> bool:
-    """Whether some cell has a graded cost (between free and inscribed, exclusive): the mark
-    of an inflation filter."""
-    data = costmap.data
-    return bool(((data > 0) & (data < INSCRIBED_INFLATED_OBSTACLE)).any())
+def window_cells(costmap: Costmap2D, cx: float, cy: float, half_size: float,
+                 pad: int = 0) -> tuple[int, int, int, int]:
+    """The cells ``[i0, i1) x [j0, j1)`` within ``half_size`` (m) of ``(cx, cy)``, widened by
+    ``pad`` cells and cut to the map (empty when the window is off it)."""
+    res = float(costmap.resolution)
+    i0 = int(math.floor((cx - half_size - costmap.origin_x) / res)) - pad
+    j0 = int(math.floor((cy - half_size - costmap.origin_y) / res)) - pad
+    i1 = int(math.floor((cx + half_size - costmap.origin_x) / res)) + pad + 1
+    j1 = int(math.floor((cy + half_size - costmap.origin_y) / res)) + pad + 1
+    i0, j0 = min(max(i0, 0), costmap.width), min(max(j0, 0), costmap.height)
+    return i0, j0, max(min(i1, costmap.width), i0), max(min(j1, costmap.height), j0)
+
+
+def needs_local_inflation(costmap: Costmap2D, cx: float, cy: float, half_size: float,
+                          inflation_radius: float) -> bool:
+    """Whether the window (widened by the radius) has lethal cells and no graded cost (between
+    free and inscribed, exclusive): obstacles an inflation filter has not been over. Looks at
+    the window only: a full-map scan would cost the RT thread tens of milliseconds on a large
+    map each time the maps manager writes a new one."""
+    pad = int(math.ceil(max(inflation_radius, 0.0) / costmap.resolution))
+    i0, j0, i1, j1 = window_cells(costmap, cx, cy, half_size, pad)
+    data = costmap.data[j0:j1, i0:i1]
+    if not (data == LETHAL_OBSTACLE).any():
+        return False
+    return not ((data > 0) & (data < INSCRIBED_INFLATED_OBSTACLE)).any()
 
 
 class LocalInflation:
@@ -56,7 +77,8 @@ class LocalInflation:
 
     Seeds are the lethal cells (within the window widened by the radius; off the map there are
     none, as for an inflation filter). :meth:`at` looks the costs up at points, as
-    :func:`rollout_costs` does on a costmap: the cell under each point; beyond the window, 0.
+    :func:`rollout_costs` does on a costmap: the cell under each point; beyond the window (cut
+    to the map), 0. ``(cx, cy)`` and ``half_size`` must be finite.
 
     Pure data; any thread. Exceptions: none.
     """
@@ -68,11 +90,8 @@ class LocalInflation:
         self.resolution = res
         self.origin = (float(costmap.origin_x), float(costmap.origin_y))
         k = int(math.ceil(max(inflation_radius, 0.0) / res))
-        self.i0 = int(math.floor((cx - half_size - costmap.origin_x) / res))
-        self.j0 = int(math.floor((cy - half_size - costmap.origin_y) / res))
-        i1 = int(math.floor((cx + half_size - costmap.origin_x) / res))
-        j1 = int(math.floor((cy + half_size - costmap.origin_y) / res))
-        width, height = max(i1 - self.i0 + 1, 1), max(j1 - self.j0 + 1, 1)
+        self.i0, self.j0, i1, j1 = window_cells(costmap, cx, cy, half_size)
+        width, height = i1 - self.i0, j1 - self.j0
         # The lethal mask of the window padded by k cells.
         lethal = np.zeros((height + 2 * k, width + 2 * k), dtype=bool)
         pi0, pj0 = self.i0 - k, self.j0 - k
@@ -96,11 +115,13 @@ class LocalInflation:
         for dx in range(-k, k + 1):
             np.minimum(squared, squared_vertical[:, k + dx:k + dx + width] + dx * dx, out=squared)
         table = inflation_cost_table(k, res, inscribed_radius, cost_scaling_factor)
-        self.costs = table[np.minimum(squared, len(table) - 1)]
+        self.costs = table[np.minimum(squared, len(table) - 1)]  # (0, 0) off the map
 
     def at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """The costs (uint8, the shape of ``x``) of the cells under the points ``(x, y)``."""
         height, width = self.costs.shape
+        if height == 0 or width == 0:
+            return np.zeros(np.shape(x), dtype=np.uint8)
         ix = np.floor((x - np.float32(self.origin[0])) * np.float32(1.0 / self.resolution))
         iy = np.floor((y - np.float32(self.origin[1])) * np.float32(1.0 / self.resolution))
         ix = ix.astype(np.int32) - np.int32(self.i0)

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+import math
 
 import numpy as np
 
 from easynav.controllers.mppi.collision_model import CollisionModel, rollout_costs
 from easynav.controllers.mppi.critic import Critic
-from easynav.controllers.mppi.local_inflation import LocalInflation, has_inflation
+from easynav.controllers.mppi.local_inflation import LocalInflation, needs_local_inflation
 from easynav.controllers.mppi.mppi_batch import MppiBatch
 from easynav.core.plugins import Param
 from easynav.core.types import LETHAL_OBSTACLE
@@ -28,8 +27,9 @@ class CostCritic(Critic):
     ``near_goal_distance`` of the goal (a goal near a wall stays reachable). No costmap in
     NavState: no term.
 
-    A costmap without inflation (no cell between free and inscribed: a SimpleMap or a GridMap
-    read as a costmap, a costmap with no inflation filter) is inflated near the robot with
+    Obstacles without inflation (no cell between free and inscribed round them: a SimpleMap or
+    a GridMap read as a costmap, a costmap with no inflation filter) are inflated near the
+    robot, for this term only, with
     ``inflation_radius`` and ``cost_scaling_factor`` (:class:`LocalInflation`; the inscribed
     radius is ``robot_geometry.radius``): without the graded costs the path critics pull the
     robot across the corners of obstacles up to the collision margin.
@@ -54,10 +54,6 @@ class CostCritic(Critic):
               "(beyond Nav2)", "1/m", ge=0.0),
     )
 
-    def __init__(self, values: Mapping[str, Any]) -> None:
-        super().__init__(values)
-        self._checked: tuple[object, bool] = (None, False)  # (costmap, has_inflation)
-
     def score(self, batch: MppiBatch) -> None:
         if not self.param("enabled") or batch.costmap is None:
             return
@@ -71,14 +67,9 @@ class CostCritic(Critic):
         batch.costs += np.float32(self.param("collision_cost")) * collided
         if batch.remaining < self.param("near_goal_distance"):
             return
-        if self.param("inflation_radius") > 0.0 and not self._inflated(batch.costmap):
-            x0, y0 = np.float32(batch.pose[0]), np.float32(batch.pose[1])
-            half_size = float(max(np.abs(x - x0).max(), np.abs(y - y0).max()))
-            local = LocalInflation(batch.costmap, batch.pose[0], batch.pose[1],
-                                   half_size + batch.costmap.resolution,
-                                   self.param("inflation_radius"), collision.radius,
-                                   self.param("cost_scaling_factor"))
-            costs = np.maximum(costs, local.at(x, y))
+        inflation = self._local_inflation(batch, x, y, collision.radius)
+        if inflation is not None:
+            costs = np.maximum(costs, inflation.at(x, y))
         graded = np.where(lethal, 0, costs).sum(axis=1, dtype=np.float32)
         # Costs normalised to [0, 1] (÷ 254, as Nav2) so the weight is comparable with the
         # other critics' (metres, radians).
@@ -86,12 +77,25 @@ class CostCritic(Critic):
         power = self.param("cost_power")
         batch.costs += term if power == 1 else term**power
 
-    def _inflated(self, costmap) -> bool:
-        """Whether ``costmap`` has an inflation filter's graded costs (checked once per map
-        object: the maps managers write a new one when it changes)."""
-        if self._checked[0] is not costmap:
-            self._checked = (costmap, has_inflation(costmap))
-        return self._checked[1]
+    def _local_inflation(self, batch: MppiBatch, x: np.ndarray, y: np.ndarray,
+                         radius: float) -> LocalInflation | None:
+        """The inflation of the window the points ``(x, y)`` span, when its obstacles have
+        none (and ``inflation_radius`` is set); else None. Non-finite points are left out
+        (they collide anyway)."""
+        inflation_radius = self.param("inflation_radius")
+        x0, y0 = batch.pose[0], batch.pose[1]
+        if inflation_radius <= 0.0 or not (math.isfinite(x0) and math.isfinite(y0)):
+            return None
+        finite = np.isfinite(x) & np.isfinite(y)
+        if not finite.any():
+            return None
+        costmap = batch.costmap
+        half_size = float(max(np.abs(x[finite] - np.float32(x0)).max(),
+                              np.abs(y[finite] - np.float32(y0)).max())) + costmap.resolution
+        if not needs_local_inflation(costmap, x0, y0, half_size, inflation_radius):
+            return None
+        return LocalInflation(costmap, x0, y0, half_size, inflation_radius, radius,
+                              self.param("cost_scaling_factor"))
 
     def compute(self, batch: MppiBatch) -> np.ndarray | None:  # pragma: no cover - score()
         """Not used: this critic adds its two terms (collision, graded cost) in :meth:`score`."""
