@@ -29,10 +29,10 @@ class CostCritic(Critic):
 
     Obstacles without inflation (no cell between free and inscribed round them: a SimpleMap or
     a GridMap read as a costmap, a costmap with no inflation filter) are inflated near the
-    robot, for this term only, with
-    ``inflation_radius`` and ``cost_scaling_factor`` (:class:`LocalInflation`; the inscribed
-    radius is ``robot_geometry.radius``): without the graded costs the path critics pull the
-    robot across the corners of obstacles up to the collision margin.
+    robot, for this term only, with ``inflation_radius`` and ``cost_scaling_factor``
+    (:class:`LocalInflation`; the inscribed radius is ``robot_geometry.radius``): without the
+    graded costs the path critics pull the robot across the corners of obstacles up to the
+    collision margin.
     """
 
     NAME = "CostCritic"
