@@ -419,6 +419,29 @@ def test_a_robot_escapes_to_the_side_its_goal_is_on():
     assert_clear(costmap, result.poses, 0.25)
 
 
+@pytest.mark.parametrize("space", ["SE2", "ReedsShepp", "Dubins"])
+def test_a_goal_inside_the_clearance_is_approached_along_a_segment_its_body_clears(space):
+    costmap = wall_map()
+    # 0.35 m left of the wall (x 4.75), facing it: inside the 0.4 m footprint, the 0.3 m body
+    # clear (a sensor hit beyond a wall can put a waypoint there). OMPL plans to a point behind
+    # it along its heading; the path ends with the straight drive in.
+    goal = (4.40, 4.0, 0.0)
+    ompl = make(space, seed=4, robot_radius=0.3, clearance_distance=0.1, turning_radius=0.4)
+    assert "goal (4.40, 4.00) is closer than" in ompl.pose_problem(costmap, 4.40, 4.0, "goal")
+    result = ompl.plan(costmap, (2.0, 2.0, 0.0), goal)
+    assert result.ok, result.reason
+    poses, approach = result.poses, result.approach
+    assert poses[-1].tolist() == pytest.approx(list(goal))
+    assert approach > 0
+    drive_in = poses[-approach - 1 :]
+    assert (np.diff(drive_in[:, 0]) > 0).all() and (drive_in[:, 1] == 4.0).all()
+    assert drive_in[:, 2] == pytest.approx(np.zeros(len(drive_in)))  # along the goal's yaw
+    assert_clear(costmap, drive_in, 0.30)  # the body never touches the wall
+    # OMPL's part keeps the footprint (body + clearance) clear, up to where the approach starts.
+    assert_clear(costmap, poses[: len(poses) - approach], 0.40)
+    assert not ompl.checker(costmap).is_free(4.40, 4.0)  # the approach is needed
+
+
 def test_a_robot_touching_an_obstacle_has_no_escape():
     result = make(seed=1).plan(wall_map(), (4.55, 4.0, 0.0), (2.0, 2.0, 0.0))
     assert not result.ok and "start (4.55, 4.00) is closer than" in result.reason

@@ -173,6 +173,34 @@ def test_a_plan_that_starts_with_an_escape_is_kept():
     assert nav_state.get("path", Path) is path and planner.plan_count == 1
 
 
+def test_a_goal_inside_the_clearance_of_the_current_map_is_approached_and_the_plan_kept():
+    planner = make_planner()
+    # In the cell centred 0.30 m from the wall's cell centres (x = 4.025), less half a cell
+    # diagonal (the checker's rule): inside the 0.25 + 0.1 m footprint and inside the body +
+    # half the clearance a plan is kept with, the 0.25 m body clear.
+    nav_state = state_with((3.72, 1.0, 0.0))
+    planner.update(nav_state)
+    path = nav_state.get("path", Path)
+    assert len(path) > 0 and path.as_xy_yaw()[-1].tolist() == pytest.approx([3.72, 1.0, 0.0])
+    keep = planner.planner.keep_checker(room())
+    assert not keep.polyline_free(path.as_xy_yaw()[:, :2])[0]
+    planner.update(nav_state)
+    assert nav_state.get("path", Path) is path and planner.plan_count == 1
+    # An obstacle that the body would touch at the goal drops the plan: the goal is impossible.
+    blocked = room()
+    blocked.data[20, 77] = 254  # the cell centred at (3.875, 1.025)
+    nav_state.set("map", blocked)
+    planner.update(nav_state)
+    assert planner.plan_count == 2 and len(nav_state.get("path", Path)) == 0
+    assert "goal (3.72, 1.00) is closer than" in diagnostic(nav_state).message
+    # The same goal too close to a wall of the static map is the goal's fault: rejected.
+    strict = make_planner()
+    nav_state = state_with((3.72, 1.0, 0.0))
+    nav_state.set("map.base", room())
+    strict.update(nav_state)
+    assert "goal (3.72, 1.00) is closer than" in strict.take_goal_rejection()
+
+
 def test_an_unreachable_goal_gives_an_empty_path_and_a_warning():
     world = room()
     world.data[:, 80:82] = 254  # close the door

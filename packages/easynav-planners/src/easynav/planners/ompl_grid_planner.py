@@ -153,6 +153,13 @@ class OMPLGridPlanner:
     where the robot cannot go, and RRTConnect measured 0.3-1.3 s (failing at 1 s) between
     the sandbox's pillars, 0.01-0.18 s in the box.
 
+    A start inside the clearance of an obstacle, the robot's body clear of it, is left by a
+    straight escape to the nearest point OMPL may start from (:meth:`escape_point`); a goal
+    there is reached by a straight approach from the nearest point OMPL may plan to
+    (:meth:`approach_point`). Both segments are checked against the body alone; the path still
+    starts at the start and ends at the goal (``PlanResult.approach`` counts the approach's
+    poses).
+
     The returned path is checked again, as straight segments between its poses sampled every
     half cell. A path that fails is planned again (with a stricter margin when the start and
     goal allow it, else with new random samples), within one more ``solve_time``; one still
@@ -345,6 +352,19 @@ class OMPLGridPlanner:
                 return float(px[k]), float(py[k])
         return None
 
+    def approach_point(
+        self, costmap: Costmap2D, goal: tuple[float, float, float], start: tuple[float, float]
+    ) -> tuple[float, float] | None:
+        """Where the path to a ``goal`` that stands inside the clearance of an obstacle (its body
+        clear of it) leaves OMPL's part for a straight approach the body clears: the nearest
+        point OMPL may plan to within :data:`ESCAPE_DISTANCE`, in ``start``'s free region when
+        the start has one. Searched as :meth:`escape_point` searches, along the goal's heading
+        first, so that the robot arrives straight along its final yaw: behind the goal only for
+        Dubins (a forward car drives in), behind or ahead otherwise. None when the body touches
+        an obstacle at the goal or no such point is in reach."""
+        yaw = goal[2] + math.pi if self.state_space == "Dubins" else goal[2]
+        return self.escape_point(costmap, goal[0], goal[1], yaw, goal=start)
+
     # -- checks ---------------------------------------------------------------------------------
     def pose_problem(self, costmap: Costmap2D, x: float, y: float, what: str) -> str | None:
         """Why the robot cannot be at ``(x, y)`` (``what`` names it: "goal", "start"), or None."""
@@ -380,6 +400,14 @@ class OMPLGridPlanner:
         problem = self.pose_problem(costmap, goal[0], goal[1], "goal")
         checker, planning_checker, strict_checker = self._checkers(costmap)
         robot = start
+        # A goal inside the clearance, the body clear of obstacles (a laser hit a hair beyond a
+        # wall fills a cell past it), is reached by a straight approach from the nearest point
+        # OMPL may plan to, as a start there is left by an escape.
+        target = goal
+        if problem is not None and self._body.is_free(goal[0], goal[1]):
+            point = self.approach_point(costmap, goal, start[:2])
+            if point is not None:
+                target, problem = (point[0], point[1], goal[2]), None
         if (
             problem is None
             and planning_checker.is_on_map(start[0], start[1])
@@ -387,7 +415,7 @@ class OMPLGridPlanner:
         ):
             # A robot that drifted into the clearance of a wall plans from the nearest clear
             # point, reached by a straight segment its body clears (as SimplePlanner escapes).
-            point = self.escape_point(costmap, *start, goal=goal[:2])
+            point = self.escape_point(costmap, *start, goal=target[:2])
             if point is not None:
                 start = (point[0], point[1], start[2])
         if problem is None:
@@ -397,7 +425,7 @@ class OMPLGridPlanner:
             return PlanResult(reason=problem)
         goal_text = f"goal ({goal[0]:.2f}, {goal[1]:.2f})"
         unreachable = f"{goal_text} is unreachable from ({robot[0]:.2f}, {robot[1]:.2f})"
-        if not planning_checker.connected(start[:2], goal[:2]):
+        if not planning_checker.connected(start[:2], target[:2]):
             self.last_stats = PlanStats(status="no free region joins start and goal")
             return PlanResult(
                 reason=(
@@ -407,7 +435,7 @@ class OMPLGridPlanner:
             )
         with _SEED_LOCK if self.seed > 0 else contextlib.nullcontext():
             self._seed_ompl()
-            poses, status = self._solve(costmap, planning_checker, start, goal, self.solve_time)
+            poses, status = self._solve(costmap, planning_checker, start, target, self.solve_time)
             retry_until = time.perf_counter() + self.solve_time
             strict_tried = False
             while poses is not None and not checker.polyline_free(poses[:, :2])[0]:
@@ -419,10 +447,10 @@ class OMPLGridPlanner:
                 if left <= 0.0:
                     break
                 refused = poses
-                if not strict_tried and strict_checker.connected(start[:2], goal[:2]):
-                    poses, status = self._solve(costmap, strict_checker, start, goal, left)
+                if not strict_tried and strict_checker.connected(start[:2], target[:2]):
+                    poses, status = self._solve(costmap, strict_checker, start, target, left)
                 else:
-                    poses, status = self._solve(costmap, planning_checker, start, goal, left)
+                    poses, status = self._solve(costmap, planning_checker, start, target, left)
                 strict_tried = True
                 if poses is None:
                     poses = refused  # reported below as refused, not as "no path found"
@@ -435,6 +463,13 @@ class OMPLGridPlanner:
                 )
             )
         ok, index = checker.polyline_free(poses[:, :2])
+        approach = 0
+        if ok and target != goal:
+            segment = self._approach_segment(target, goal)
+            ok, index = self._body.polyline_free(segment[:, :2])
+            index += len(poses) - 1
+            poses = np.concatenate([poses[:-1], segment])
+            approach = len(segment) - 1
         if ok and robot != start:
             escape = self._escape_segment(robot, start)
             ok, index = self._body.polyline_free(escape[:, :2])
@@ -447,7 +482,7 @@ class OMPLGridPlanner:
                     f"({x:.2f}, {y:.2f}); refused"
                 )
             )
-        return PlanResult(poses=poses)
+        return PlanResult(poses=poses, approach=approach)
 
     def _escape_segment(self, robot, start) -> np.ndarray:
         """Poses from the robot to the escape point every ``interpolation_step``: facing along
@@ -458,6 +493,18 @@ class OMPLGridPlanner:
             yaw = robot[2]
         ends = np.array([[robot[0], robot[1], yaw], [start[0], start[1], yaw]])
         return densify(ends, self.interpolation_step)
+
+    def _approach_segment(self, target, goal) -> np.ndarray:
+        """Poses from the approach point to the goal every ``interpolation_step``: facing along
+        the segment in SE2 (the last has the goal's yaw), keeping the goal's yaw for a car (it
+        drives straight in along it, see :meth:`approach_point`)."""
+        yaw = goal[2]
+        if self.state_space == "SE2":
+            yaw = math.atan2(goal[1] - target[1], goal[0] - target[0])
+        ends = np.array([[target[0], target[1], yaw], [goal[0], goal[1], yaw]])
+        segment = densify(ends, self.interpolation_step)
+        segment[-1, 2] = goal[2]
+        return segment
 
     def _space(self, ob):
         if self.state_space == "SE2":

@@ -57,8 +57,11 @@ class OMPLPlanner(PathPlannerBase):
     it) and the robot stays within ``replan_deviation`` of it; otherwise the planner plans again
     from the robot's pose. An unreachable goal gives an empty path and a WARN
     diagnostic naming it; a goal impossible on the static map (``map.base``: off the map,
-    inside or too close to a wall) is rejected (the mission aborts). A path is never written
-    unless its interpolated poses, joined by straight segments, are clear of obstacles.
+    inside or too close to a wall) is rejected (the mission aborts), while one that only the
+    current ``map`` puts inside the clearance (a sensor hit beyond a wall), the body clear, is
+    reached by a straight approach at the end of the path (:meth:`OMPLGridPlanner.plan`). A
+    path is never written unless its interpolated poses, joined by straight segments, are clear
+    of obstacles (the body alone on an escape or an approach).
 
     Thread contract: ``initialize`` and runtime parameter changes in the configuring / parameter
     thread while the loops do not run this plugin; ``update`` in the non-RT thread (it blocks it
@@ -106,6 +109,8 @@ class OMPLPlanner(PathPlannerBase):
         self._path: Path | None = None
         self._path_xy_yaw: np.ndarray | None = None
         self._path_goal: tuple | None = None
+        #: Poses at the end of the current path that approach a goal inside the clearance.
+        self._approach = 0
         self._map_source: Any = None
         self._map_costmap: Costmap2D | None = None
         #: Plans made since initialisation (for tests and tools).
@@ -160,6 +165,7 @@ class OMPLPlanner(PathPlannerBase):
         self._path = None
         self._path_xy_yaw = None
         self._path_goal = None
+        self._approach = 0
 
     # -- update -------------------------------------------------------------------------------
     def _costmap(self, world: Any) -> Costmap2D:
@@ -208,6 +214,7 @@ class OMPLPlanner(PathPlannerBase):
             return
         path = Path.from_xy_yaw(result.poses, Header(self.now(), map_frame))
         self._path, self._path_xy_yaw, self._path_goal = path, result.poses, goal
+        self._approach = result.approach
         stats = planner.last_stats
         self.logger.debug(
             f"{self.plugin_name}: {planner.planner} in {planner.state_space}: path of "
@@ -218,7 +225,8 @@ class OMPLPlanner(PathPlannerBase):
 
     def _path_still_good(self, costmap: Costmap2D, robot_xy: tuple[float, float]) -> bool:
         """Whether the robot is near the current path and the path ahead keeps the body and
-        half the clearance off obstacles.
+        half the clearance off obstacles (the body alone on an escape it starts with and on the
+        approach to a goal inside the clearance it ends with).
 
         A path is planned with ``clearance_distance`` and kept while the body and half of it
         (:meth:`OMPLGridPlanner.keep_checker`) clear it: an obstacle on or beside the way drops
@@ -235,11 +243,18 @@ class OMPLPlanner(PathPlannerBase):
         # near the same place twice, and the earlier pass is the one still ahead.
         ahead = int(np.argmax(distance <= nearest + 0.1))
         keep = self.planner.keep_checker(costmap)
-        # A path may start with an escape out of the clearance, which only the body clears.
-        clear = keep.are_free(xy[ahead:])
-        escape = int(np.argmax(clear)) if clear.any() else len(clear) - 1
         body = self.planner.body_checker(costmap)
+        # A path may end with the approach to a goal inside the clearance (the last
+        # ``approach`` poses, planned so), which only the body clears.
+        approach = len(xy) - 1 - self._approach
+        if ahead >= approach:
+            return body.polyline_free(xy[ahead:])[0]
+        if self._approach and not body.polyline_free(xy[approach:])[0]:
+            return False
+        # It may start with an escape out of the clearance, which only the body clears.
+        clear = keep.are_free(xy[ahead : approach + 1])
+        escape = int(np.argmax(clear)) if clear.any() else len(clear) - 1
         return (
             body.polyline_free(xy[ahead : ahead + escape + 1])[0]
-            and keep.polyline_free(xy[ahead + escape :])[0]
+            and keep.polyline_free(xy[ahead + escape : approach + 1])[0]
         )

@@ -14,11 +14,15 @@ def _no_poses() -> np.ndarray:
 @dataclass(frozen=True, slots=True)
 class PlanResult:
     """``poses``: ``(K, 3)`` array of ``x, y, yaw`` (empty when there is no path); ``reason``:
-    a sentence saying why there is no path (empty when there is one).
+    a sentence saying why there is no path (empty when there is one); ``approach``: how many
+    poses at the end of the path are the straight approach to a goal that stands inside the
+    clearance kept from obstacles (``poses[-approach - 1:]``, which the robot's body alone
+    clears; 0 when the whole path keeps the clearance).
     """
 
     poses: np.ndarray = field(default_factory=_no_poses)
     reason: str = ""
+    approach: int = 0
 
     @property
     def ok(self) -> bool:
