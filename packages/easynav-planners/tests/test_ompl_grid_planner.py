@@ -442,6 +442,67 @@ def test_a_goal_inside_the_clearance_is_approached_along_a_segment_its_body_clea
     assert not ompl.checker(costmap).is_free(4.40, 4.0)  # the approach is needed
 
 
+@pytest.mark.parametrize("space", ["SE2", "ReedsShepp", "Dubins"])
+def test_a_goal_with_its_back_to_the_wall_is_approached_from_ahead_but_not_by_a_forward_car(
+    space,
+):
+    # As above, facing away from the wall: behind it, the wall. SE2 comes from ahead and turns
+    # on the spot; Reeds-Shepp backs in along the goal's yaw; a Dubins car cannot drive in
+    # forwards, and a sideways approach is no car's: refused, saying why.
+    costmap = wall_map()
+    goal = (4.40, 4.0, math.pi)
+    ompl = make(space, seed=4, robot_radius=0.3, clearance_distance=0.1, turning_radius=0.4)
+    result = ompl.plan(costmap, (2.0, 2.0, 0.0), goal)
+    if space == "Dubins":
+        assert not result.ok
+        assert "goal (4.40, 4.00) is closer than" in result.reason
+        assert "no point to plan to is within 1 m" in result.reason
+        return
+    assert result.ok, result.reason
+    poses, approach = result.poses, result.approach
+    drive_in = poses[-approach - 1 :]
+    assert approach > 0 and (np.diff(drive_in[:, 0]) > 0).all()
+    assert abs(poses[-1, 2]) == pytest.approx(math.pi)
+    assert np.abs(drive_in[:-1, 2]) == pytest.approx(
+        np.full(approach, 0.0 if space == "SE2" else math.pi)
+    )
+    assert_clear(costmap, drive_in, 0.30)
+
+
+def test_a_start_and_a_goal_inside_the_clearance_get_an_escape_and_an_approach():
+    costmap = wall_map()
+    start, goal = (4.40, 2.0, 0.0), (4.40, 6.0, 0.0)
+    ompl = make(seed=4, robot_radius=0.3, clearance_distance=0.1)
+    result = ompl.plan(costmap, start, goal)
+    assert result.ok, result.reason
+    poses, approach = result.poses, result.approach
+    assert poses[0].tolist()[:2] == [4.40, 2.0] and poses[-1].tolist() == pytest.approx(list(goal))
+    assert_clear(costmap, poses, 0.30)
+    footprint = ompl.checker(costmap).are_free(poses[:, :2])
+    first_clear = int(np.argmax(footprint))
+    assert 0 < first_clear < len(poses) - approach - 1
+    assert_clear(costmap, poses[first_clear : len(poses) - approach], 0.40)
+    assert (np.diff(poses[-approach - 1 :, 0]) > 0).all()
+
+
+def test_a_goal_the_body_does_not_fit_is_refused_saying_so():
+    result = make(seed=1, robot_radius=0.3).plan(wall_map(), (2.0, 2.0, 0.0), (4.5, 2.0, 0.0))
+    assert not result.ok
+    assert "goal (4.50, 2.00) is closer than robot_radius (0.30 m)" in result.reason
+    assert "does not fit" in result.reason
+
+
+@pytest.mark.parametrize("space", ["SE2", "ReedsShepp", "Dubins"])
+def test_a_goal_facing_minus_x_is_planned_to(space):
+    # A yaw of exactly pi (a quaternion (0, 0, 1, 0)) is outside OMPL's [-pi, pi) SO2 bounds:
+    # the goal was once "invalid" and the plan failed.
+    ompl = make(space, seed=4, robot_radius=0.3, clearance_distance=0.1, turning_radius=0.4)
+    for start, goal in (((2.0, 6.0, 0.0), (2.0, 2.0, math.pi)), ((2.0, 2.0, math.pi), (3, 6, 0))):
+        result = ompl.plan(wall_map(), start, goal)
+        assert result.ok, result.reason
+        assert result.poses[-1, :2].tolist() == pytest.approx(list(goal[:2]))
+
+
 def test_a_robot_touching_an_obstacle_has_no_escape():
     result = make(seed=1).plan(wall_map(), (4.55, 4.0, 0.0), (2.0, 2.0, 0.0))
     assert not result.ok and "start (4.55, 4.00) is closer than" in result.reason

@@ -186,6 +186,9 @@ def test_a_goal_inside_the_clearance_of_the_current_map_is_approached_and_the_pl
     assert not keep.polyline_free(path.as_xy_yaw()[:, :2])[0]
     planner.update(nav_state)
     assert nav_state.get("path", Path) is path and planner.plan_count == 1
+    set_robot(nav_state, (3.72, 1.0))  # at the goal, on the approach: still kept
+    planner.update(nav_state)
+    assert nav_state.get("path", Path) is path and planner.plan_count == 1
     # An obstacle that the body would touch at the goal drops the plan: the goal is impossible.
     blocked = room()
     blocked.data[20, 77] = 254  # the cell centred at (3.875, 1.025)
@@ -199,6 +202,23 @@ def test_a_goal_inside_the_clearance_of_the_current_map_is_approached_and_the_pl
     nav_state.set("map.base", room())
     strict.update(nav_state)
     assert "goal (3.72, 1.00) is closer than" in strict.take_goal_rejection()
+
+
+def test_a_plan_without_an_approach_is_kept_at_its_end_with_half_the_clearance_only():
+    planner = make_planner()
+    nav_state = state_with((7.0, 1.0, 0.0))
+    planner.update(nav_state)
+    path = nav_state.get("path", Path)
+    set_robot(nav_state, (7.0, 1.0))  # at the goal
+    planner.update(nav_state)
+    assert nav_state.get("path", Path) is path and planner.plan_count == 1
+    # A cell centred 0.30 m from the goal's cell centre: the body clear there, half the
+    # clearance not. The robot at the end of the plan does not keep it.
+    narrowed = room()
+    narrowed.data[26, 140] = 254
+    nav_state.set("map", narrowed)
+    planner.update(nav_state)
+    assert planner.plan_count == 2
 
 
 def test_an_unreachable_goal_gives_an_empty_path_and_a_warning():

@@ -308,11 +308,13 @@ class OMPLGridPlanner:
         y: float,
         yaw: float,
         goal: tuple[float, float] | None = None,
+        along_heading_only: bool = False,
     ) -> tuple[float, float] | None:
         """Where a robot that stands inside the clearance of an obstacle (its body clear of it)
         gets out: the nearest point OMPL may start from within :data:`ESCAPE_DISTANCE`, first
-        straight ahead or behind along its heading (ahead only for Dubins), else in any
-        direction, reached by a straight segment its body (``robot_radius``) clears. With a
+        straight ahead or behind along its heading (ahead only for Dubins), else (unless
+        ``along_heading_only``) in any direction, reached by a straight segment its body
+        (``robot_radius``) clears. With a
         ``goal`` (x, y), only points in the goal's free region count: the nearest point may lie
         in a pocket no path leaves, such as a gap between two boxes. None when the body itself
         touches an obstacle or no such point is in reach."""
@@ -337,6 +339,8 @@ class OMPLGridPlanner:
                     np.array([[x, y], [px, py]])
                 )[0]:
                     return float(px), float(py)
+        if along_heading_only:
+            return None
         # Any direction: the free cell centres within reach, nearest first.
         reach = math.ceil(ESCAPE_DISTANCE / costmap.resolution)
         cx, cy = (int(v) for v in costmap.world_to_cell(x, y))
@@ -358,12 +362,15 @@ class OMPLGridPlanner:
         """Where the path to a ``goal`` that stands inside the clearance of an obstacle (its body
         clear of it) leaves OMPL's part for a straight approach the body clears: the nearest
         point OMPL may plan to within :data:`ESCAPE_DISTANCE`, in ``start``'s free region when
-        the start has one. Searched as :meth:`escape_point` searches, along the goal's heading
-        first, so that the robot arrives straight along its final yaw: behind the goal only for
-        Dubins (a forward car drives in), behind or ahead otherwise. None when the body touches
-        an obstacle at the goal or no such point is in reach."""
-        yaw = goal[2] + math.pi if self.state_space == "Dubins" else goal[2]
-        return self.escape_point(costmap, goal[0], goal[1], yaw, goal=start)
+        the start has one. Searched as :meth:`escape_point` searches, along the goal's heading,
+        behind it first, so that the robot drives in along its final yaw: behind only for Dubins
+        (a forward car), behind or ahead for Reeds–Shepp (ahead: it backs in), and for SE2 in
+        any direction when neither is free (it turns on the spot at the goal). None when the
+        body touches an obstacle at the goal or no such point is in reach."""
+        return self.escape_point(
+            costmap, goal[0], goal[1], goal[2] + math.pi, goal=start,
+            along_heading_only=self.state_space != "SE2",
+        )
 
     # -- checks ---------------------------------------------------------------------------------
     def pose_problem(self, costmap: Costmap2D, x: float, y: float, what: str) -> str | None:
@@ -385,6 +392,11 @@ class OMPLGridPlanner:
             )
         return None
 
+    def _in_clearance(self, costmap: Costmap2D, x: float, y: float) -> bool:
+        """On the map and not in an obstacle cell (the pose may still fail the footprint)."""
+        ix, iy = costmap.world_to_cell(x, y)
+        return bool(costmap.in_bounds(ix, iy)) and not self._checker.obstacle[int(iy), int(ix)]
+
     # -- planning -------------------------------------------------------------------------------
     def plan(
         self,
@@ -404,10 +416,23 @@ class OMPLGridPlanner:
         # wall fills a cell past it), is reached by a straight approach from the nearest point
         # OMPL may plan to, as a start there is left by an escape.
         target = goal
-        if problem is not None and self._body.is_free(goal[0], goal[1]):
-            point = self.approach_point(costmap, goal, start[:2])
-            if point is not None:
-                target, problem = (point[0], point[1], goal[2]), None
+        if problem is not None and self._in_clearance(costmap, goal[0], goal[1]):
+            if not self._body.is_free(goal[0], goal[1]):
+                problem = (
+                    f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is closer than robot_radius "
+                    f"({self.robot_radius:.2f} m) to an obstacle or the map edge: the robot "
+                    f"does not fit there"
+                )
+            else:
+                point = self.approach_point(costmap, goal, start[:2])
+                if point is not None:
+                    target, problem = (point[0], point[1], goal[2]), None
+                else:
+                    problem += (
+                        f", and no point to plan to is within {ESCAPE_DISTANCE:g} m of it "
+                        f"along a straight way the robot's body clears (along its heading "
+                        f"for a car)"
+                    )
         if (
             problem is None
             and planning_checker.is_on_map(start[0], start[1])
@@ -416,6 +441,15 @@ class OMPLGridPlanner:
             # A robot that drifted into the clearance of a wall plans from the nearest clear
             # point, reached by a straight segment its body clears (as SimplePlanner escapes).
             point = self.escape_point(costmap, *start, goal=target[:2])
+            if point is None and target != goal:
+                # Both stand in the clearance, and the approach chosen first (in any region:
+                # the start has none) is not in a region the start escapes to: escape first,
+                # then approach in the escape's region.
+                point = self.escape_point(costmap, *start)
+                if point is not None:
+                    other = self.approach_point(costmap, goal, point)
+                    if other is not None:
+                        target = (other[0], other[1], goal[2])
             if point is not None:
                 start = (point[0], point[1], start[2])
         if problem is None:
@@ -568,7 +602,10 @@ class OMPLGridPlanner:
         for state, (x, y, yaw) in ((start_state, start), (goal_state, goal)):
             state.setX(x)
             state.setY(y)
-            state.setYaw(math.atan2(math.sin(yaw), math.cos(yaw)))
+            # OMPL's SO2 bounds are [-pi, pi): a yaw of exactly pi (a pose facing -x, as a
+            # quaternion (0, 0, 1, 0) gives it) made the goal invalid, and the plan fail.
+            yaw = math.atan2(math.sin(yaw), math.cos(yaw))
+            state.setYaw(-math.pi if yaw >= math.pi else yaw)
         pdef = ob.ProblemDefinition(si)
         pdef.setStartAndGoalStates(start_state, goal_state)
         pdef.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))

@@ -247,7 +247,7 @@ class OMPLPlanner(PathPlannerBase):
         # A path may end with the approach to a goal inside the clearance (the last
         # ``approach`` poses, planned so), which only the body clears.
         approach = len(xy) - 1 - self._approach
-        if ahead >= approach:
+        if self._approach and ahead >= approach:
             return body.polyline_free(xy[ahead:])[0]
         if self._approach and not body.polyline_free(xy[approach:])[0]:
             return False
