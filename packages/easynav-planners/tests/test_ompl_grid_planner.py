@@ -485,6 +485,38 @@ def test_a_start_and_a_goal_inside_the_clearance_get_an_escape_and_an_approach()
     assert (np.diff(poses[-approach - 1 :, 0]) > 0).all()
 
 
+def gap_wall_map() -> Costmap2D:
+    """6 m x 4 m at 0.05 m, a thin wall across at y 2.00..2.05 with a 0.6 m gap (x 2.7..3.3):
+    a 0.25 m body passes the gap, a 0.35 m footprint does not (two free regions)."""
+    costmap = Costmap2D.filled(120, 80, 0.05)
+    costmap.data[40, :] = 254
+    costmap.data[40, 54:66] = 0
+    return costmap
+
+
+def test_start_and_goal_in_the_clearance_take_an_escape_and_an_approach_into_one_region():
+    # The start is 0.3 m south of the wall, 2 m from the gap: it can only escape south. The
+    # goal stands in the gap, a little north: its nearest point to plan to is north, which the
+    # start cannot reach; the approach comes from the south, through the gap, instead.
+    costmap = gap_wall_map()
+    start, goal = (1.0, 1.72, 0.0), (3.0, 2.06, 0.0)
+    ompl = make(seed=1, robot_radius=0.25, clearance_distance=0.1)
+    assert ompl.approach_point(costmap, goal, start[:2])[1] > 2.0  # the nearest: north
+    result = ompl.plan(costmap, start, goal)
+    assert result.ok, result.reason
+    poses, approach = result.poses, result.approach
+    assert poses[0, :2].tolist() == [1.0, 1.72] and poses[-1].tolist() == pytest.approx(list(goal))
+    assert (poses[:, 1] < 2.1).all()  # never north of the wall
+    drive_in = poses[-approach - 1 :]
+    assert approach > 0 and (np.diff(drive_in[:, 1]) > 0).all()  # north, into the gap
+    assert_clear(costmap, poses, 0.25)
+    # A goal north of the wall, far from the gap: no escape and approach share a region.
+    result = ompl.plan(costmap, start, (1.0, 2.33, math.pi / 2))
+    assert not result.ok
+    assert "start (1.00, 1.72) and goal (1.00, 2.33) both stand within the clearance" in (
+        result.reason)
+
+
 def test_a_goal_the_body_does_not_fit_is_refused_saying_so():
     result = make(seed=1, robot_radius=0.3).plan(wall_map(), (2.0, 2.0, 0.0), (4.5, 2.0, 0.0))
     assert not result.ok

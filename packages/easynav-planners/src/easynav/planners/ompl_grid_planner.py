@@ -395,7 +395,8 @@ class OMPLGridPlanner:
     def _in_clearance(self, costmap: Costmap2D, x: float, y: float) -> bool:
         """On the map and not in an obstacle cell (the pose may still fail the footprint)."""
         ix, iy = costmap.world_to_cell(x, y)
-        return bool(costmap.in_bounds(ix, iy)) and not self._checker.obstacle[int(iy), int(ix)]
+        obstacle = self.checker(costmap).obstacle
+        return bool(costmap.in_bounds(ix, iy)) and not obstacle[int(iy), int(ix)]
 
     # -- planning -------------------------------------------------------------------------------
     def plan(
@@ -428,10 +429,10 @@ class OMPLGridPlanner:
                 if point is not None:
                     target, problem = (point[0], point[1], goal[2]), None
                 else:
+                    way = "along its heading" if self.state_space != "SE2" else "on a straight way"
                     problem += (
                         f", and no point to plan to is within {ESCAPE_DISTANCE:g} m of it "
-                        f"along a straight way the robot's body clears (along its heading "
-                        f"for a car)"
+                        f"{way} the robot's body clears"
                     )
         if (
             problem is None
@@ -440,16 +441,23 @@ class OMPLGridPlanner:
         ):
             # A robot that drifted into the clearance of a wall plans from the nearest clear
             # point, reached by a straight segment its body clears (as SimplePlanner escapes).
-            point = self.escape_point(costmap, *start, goal=target[:2])
+            car = self.state_space != "SE2"  # a car leaves along its heading only
+            point = self.escape_point(costmap, *start, goal=target[:2], along_heading_only=car)
             if point is None and target != goal:
                 # Both stand in the clearance, and the approach chosen first (in any region:
                 # the start has none) is not in a region the start escapes to: escape first,
-                # then approach in the escape's region.
-                point = self.escape_point(costmap, *start)
-                if point is not None:
-                    other = self.approach_point(costmap, goal, point)
-                    if other is not None:
-                        target = (other[0], other[1], goal[2])
+                # then approach in the escape's region; both, or neither.
+                point = self.escape_point(costmap, *start, along_heading_only=car)
+                other = None if point is None else self.approach_point(costmap, goal, point)
+                if other is None:
+                    point = None
+                    problem = (
+                        f"start ({start[0]:.2f}, {start[1]:.2f}) and goal ({goal[0]:.2f}, "
+                        f"{goal[1]:.2f}) both stand within the clearance of an obstacle, and "
+                        f"no way out of it from the start joins a way into it to the goal"
+                    )
+                else:
+                    target = (other[0], other[1], goal[2])
             if point is not None:
                 start = (point[0], point[1], start[2])
         if problem is None:
