@@ -126,6 +126,18 @@ def test_a_robot_inside_the_margin_may_move_along_or_away_not_closer():
                           held=0.15).held is None
 
 
+def test_a_robot_over_an_obstacle_is_held_to_poses_clear_of_it():
+    costmap = wall_costmap()
+    # 0.10 m from the wall with a 0.15 m radius: the estimate overlaps it. Held at the radius,
+    # not at its depth (every pose this near collides), and kept there when found nearer.
+    model = CollisionModel(costmap, (0.90, 0.0, 0.0), 1.0, 0.15, 0.05, True)
+    assert model.threshold == pytest.approx(0.15) and model.held == pytest.approx(0.15)
+    along = np.float32([[0.90, 0.90]]), np.float32([[0.1, 0.2]])
+    assert model.colliding(*along).all()
+    nearer = CollisionModel(costmap, (0.92, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=model.held)
+    assert nearer.threshold == pytest.approx(0.15)
+
+
 def test_a_tight_path_lowers_the_threshold_never_below_the_radius():
     costmap = wall_costmap()
     def path_at(x):
