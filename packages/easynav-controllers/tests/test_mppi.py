@@ -441,21 +441,23 @@ def test_stopped_with_every_candidate_colliding_it_turns_on_the_spot_towards_the
     # Moving, it brakes first, without turning (test_brakes_when_every_candidate_collides).
 
 
-def test_a_robot_the_estimate_puts_over_an_obstacle_does_not_drive_along_it():
-    # Its 0.15 m disc overlaps a wall 0.10 m east (a laser hit drawn nearer, an estimate off),
-    # its path leading north along the wall. Held at its depth, it drove on along the wall (on
-    # the TurtleBot3 sandbox, into a pillar); it stops: every rollout collides.
+def test_a_robot_the_estimate_puts_over_an_obstacle_gets_out_and_never_nearer():
+    # Its 0.15 m disc overlaps a wall 0.10 m east (a laser hit drawn nearer, an estimate off);
+    # its path leads north, 0.25 m from the wall. Held at its depth, it drove along the wall
+    # (on the TurtleBot3 sandbox, into a pillar); it gets out, never nearer than it was.
     costmap = Costmap2D.filled(100, 100, 0.05, -2.5, -2.5)
     ix, _ = costmap.world_to_cell(0.12, 0.0)  # cells from x = 0.10 on
     costmap.data[:, ix:] = LETHAL_OBSTACLE
     limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0)
-    controller = make_controller({**NAV2_SIZE, "use_rotate_to_heading": False}, limits=limits)
-    optimizer = controller.optimizer
-    north = straight_path(2.0)[:, [1, 0, 2]] * np.array([-1.0, 1.0, 0.0]) + [0, 0, math.pi / 2]
-    for _ in range(5):
-        command = optimizer.compute((0.0, 0.0, math.pi / 2), north, 0.05, limits, 0.15, 0.15,
-                                    costmap, path_key=1, robot_radius=0.15)
-        assert command.state == "blocked" and command.v == 0.0
+    controller = make_controller(NAV2_SIZE, limits=limits, radius=0.15)
+    north = straight_path(3.0)[:, [1, 0, 2]] * np.array([-1.0, 1.0, 0.0]) + [-0.15, 0, math.pi / 2]
+    nav_state = NavState()
+    nav_state.set("map", costmap)
+    poses, _commands, _states = run_closed_loop(controller, north, (0.0, 0.0, math.pi / 2),
+                                                steps=80, nav_state=nav_state)
+    to_wall = 0.10 - poses[:, 0]
+    assert to_wall.min() >= 0.10 - 0.002  # never nearer
+    assert to_wall[-1] >= 0.15  # out: its disc clear of the wall
 
 
 def test_a_rollout_cutting_across_a_bend_does_not_reach_the_path_beyond_it():

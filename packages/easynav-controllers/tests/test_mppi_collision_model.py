@@ -126,16 +126,37 @@ def test_a_robot_inside_the_margin_may_move_along_or_away_not_closer():
                           held=0.15).held is None
 
 
-def test_a_robot_over_an_obstacle_is_held_to_poses_clear_of_it():
+def test_a_robot_over_an_obstacle_may_only_get_out():
     costmap = wall_costmap()
     # 0.10 m from the wall with a 0.15 m radius: the estimate overlaps it. Held at the radius,
-    # not at its depth (every pose this near collides), and kept there when found nearer.
+    # not at its depth, and only rollouts that get out are clear: away, or turning on the
+    # spot, not along the wall nor nearer (as each gains less than ESCAPE_GAIN per metre).
     model = CollisionModel(costmap, (0.90, 0.0, 0.0), 1.0, 0.15, 0.05, True)
-    assert model.threshold == pytest.approx(0.15) and model.held == pytest.approx(0.15)
-    along = np.float32([[0.90, 0.90]]), np.float32([[0.1, 0.2]])
-    assert model.colliding(*along).all()
+    assert model.escaping and model.threshold == pytest.approx(0.15)
+    rollouts = {
+        "away": ([0.85, 0.80, 0.70], [0.0, 0.0, 0.0]),
+        "away at 45 degrees": ([0.86, 0.82, 0.78], [0.04, 0.08, 0.12]),
+        "turning on the spot": ([0.90, 0.90, 0.90], [0.0, 0.0, 0.0]),
+        "along": ([0.90, 0.90, 0.90], [0.05, 0.10, 0.15]),
+        "nearly along": ([0.895, 0.89, 0.885], [0.05, 0.10, 0.15]),
+        "nearer": ([0.91, 0.92, 0.93], [0.0, 0.0, 0.0]),
+    }
+    expected = {"away": False, "away at 45 degrees": False, "turning on the spot": False,
+                "along": True, "nearly along": True, "nearer": True}
+    for name, (xs, ys) in rollouts.items():
+        x, y = np.float32([xs]), np.float32([ys])
+        assert model.colliding(x, y).any() == expected[name], name  # the critics' field
+        assert model.rollout_collides(x[0], y[0]) == expected[name], name  # the guard
+    # Found nearer (a hit drawn nearer): still only out, from there.
     nearer = CollisionModel(costmap, (0.92, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=model.held)
-    assert nearer.threshold == pytest.approx(0.15)
+    assert nearer.escaping and nearer.threshold == pytest.approx(0.15)
+    # Just outside the radius (0.155 m): the hold keeps its slack, below the radius.
+    near = CollisionModel(costmap, (0.845, 0.0, 0.0), 1.0, 0.15, 0.05, True)
+    assert not near.escaping
+    assert near.threshold == pytest.approx(0.155 - INSIDE_MARGIN_SLACK, abs=1e-4)
+    # Out of the margin: released.
+    out = CollisionModel(costmap, (0.5, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=model.held)
+    assert not out.escaping and out.held is None
 
 
 def test_a_tight_path_lowers_the_threshold_never_below_the_radius():

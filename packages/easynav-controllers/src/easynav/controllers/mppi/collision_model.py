@@ -30,6 +30,14 @@ from easynav.core.types import (
 #: colliding and stay blocked.
 INSIDE_MARGIN_SLACK = 0.01
 
+#: A robot the estimate puts over an obstacle must gain at least this much clearance per metre
+#: it drives (at least 30 degrees away from the obstacle's face), until its disc is clear: it
+#: may turn on the spot and get out, not slide along the obstacle nor come nearer.
+ESCAPE_GAIN = 0.5
+
+#: Float32 rounding allowed in that test (m).
+ESCAPE_TOLERANCE = 0.001
+
 
 def rollout_costs(costmap: Costmap2D, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Costmap values (uint8) at the points ``(x, y)``; off the map: NO_INFORMATION."""
@@ -186,7 +194,8 @@ class CollisionModel:
       touching;
     - a robot already nearer (a localisation jump, an obstacle seen anew) is held to poses no
       nearer than it is then (``held``, the previous cycle's :attr:`held`), until it is out
-      again; never below ``radius``.
+      again; once its disc overlaps an obstacle, only rollouts that get out are clear
+      (:data:`ESCAPE_GAIN`).
 
     Both less :data:`INSIDE_MARGIN_SLACK`. ``reach`` is the farthest a rollout can go from
     ``pose`` this cycle (m).
@@ -205,6 +214,11 @@ class CollisionModel:
         self.field: ClearanceField | None = None
         self.threshold = 0.0
         self.held: float | None = None
+        #: Whether the robot's disc overlaps an obstacle (by the estimate): only rollouts that
+        #: get out are then clear (:data:`ESCAPE_GAIN`).
+        self.escaping = False
+        self._pose = (float(pose[0]), float(pose[1]))
+        self._start = (0.0, 0.0)  # the robot's clearance: exact, and as the batch field has it
         if keep <= 0.0:
             return
         cap = keep + costmap.resolution
@@ -225,16 +239,20 @@ class CollisionModel:
             # as near as the hold let it: min(held, inside) let it INSIDE_MARGIN_SLACK nearer
             # each cycle, and the matrix saw MPPI creep into a pillar of the TurtleBot3
             # sandbox at 2 mm/s, its estimate within 4 cm.
-            # Never below the radius: a robot the estimate puts over an obstacle is held to
-            # poses clear of it (every rollout collides: it brakes and turns on the spot). Held
-            # at its depth, it once slid along a pillar of the TurtleBot3 sandbox, pressed
-            # against it at 0.45 m/s, as each laser hit drawn a centimetre nearer lowered the
-            # hold again (to 0.06 m, with a 0.15 m radius).
+            # Never below the radius once the disc overlaps an obstacle: held at its depth,
+            # a robot slid along a pillar of the TurtleBot3 sandbox and, pressed against it,
+            # drove on at 0.45 m/s, as each laser hit drawn a centimetre nearer lowered the
+            # hold again (to 0.06 m, with a 0.15 m radius). It may then only get out (a turn
+            # on the spot gains nothing and is allowed: it is never stuck for good).
             if held is None or clearance < held:
-                self.held = max(inside, radius, 0.0)
+                self.held = max(inside, radius) if clearance < radius else max(inside, 0.0)
             else:
                 self.held = held
             self.threshold = self.held
+            if clearance < radius:
+                self.escaping = True
+                start_at = float(self.field.at(np.float32([pose[0]]), np.float32([pose[1]]))[0])
+                self._start = (clearance, start_at)
         else:
             self.threshold = limit
 
@@ -243,7 +261,9 @@ class CollisionModel:
         """Boolean array (the shape of ``x``): which poses collide. ``costs``: the cells'
         values at the poses when already looked up (:func:`rollout_costs`)."""
         hit = self._on_blocked_cells(x, y, costs)
-        if self.field is not None and self.threshold > 0.0:
+        if self.escaping:
+            hit |= self._not_getting_out(x, y, self.field.at(x, y), self._start[1])
+        elif self.field is not None and self.threshold > 0.0:
             hit |= self.field.below(x, y, self.threshold)
         return hit
 
@@ -252,8 +272,24 @@ class CollisionModel:
         the command: the critics' bilinear field may be off by up to half a cell diagonal)."""
         if self._on_blocked_cells(x, y).any():
             return True
+        if self.escaping:
+            clearance = self.field.exact(x, y)
+            return bool(self._not_getting_out(x, y, clearance, self._start[0]).any())
         return bool(self.field is not None and self.threshold > 0.0
                     and (self.field.exact(x, y) < self.threshold).any())
+
+    def _not_getting_out(self, x: np.ndarray, y: np.ndarray, clearance: np.ndarray,
+                         start: float) -> np.ndarray:
+        """Which poses of rollouts (the last axis: the steps, from the robot's pose) lie
+        within the threshold with less than ``start`` (the robot's clearance) plus
+        :data:`ESCAPE_GAIN` times the distance driven to them."""
+        x = np.asarray(x, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        dx = np.diff(x, axis=-1, prepend=np.full(x.shape[:-1] + (1,), self._pose[0]))
+        dy = np.diff(y, axis=-1, prepend=np.full(y.shape[:-1] + (1,), self._pose[1]))
+        driven = np.cumsum(np.hypot(dx, dy), axis=-1)
+        needed = start + ESCAPE_GAIN * driven - ESCAPE_TOLERANCE
+        return (clearance < self.threshold) & (clearance < needed)
 
     def _on_blocked_cells(self, x: np.ndarray, y: np.ndarray,
                           costs: np.ndarray | None = None) -> np.ndarray:
