@@ -150,10 +150,15 @@ def test_a_robot_over_an_obstacle_may_only_get_out():
     # Found nearer (a hit drawn nearer): still only out, from there.
     nearer = CollisionModel(costmap, (0.92, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=model.held)
     assert nearer.escaping and nearer.threshold == pytest.approx(0.15)
-    # Just outside the radius (0.155 m): the hold keeps its slack, below the radius.
+    # Just outside the radius (0.155 m): the hold keeps its slack, below the radius; moved
+    # into that slack, over the obstacle, it may only get out again.
     near = CollisionModel(costmap, (0.845, 0.0, 0.0), 1.0, 0.15, 0.05, True)
     assert not near.escaping
     assert near.threshold == pytest.approx(0.155 - INSIDE_MARGIN_SLACK, abs=1e-4)
+    slid = CollisionModel(costmap, (0.853, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=near.held)
+    assert slid.escaping and slid.threshold == pytest.approx(0.15)
+    along = np.float32([[0.853, 0.853]]), np.float32([[0.01, 0.02]])
+    assert slid.colliding(*along).any() and slid.rollout_collides(along[0][0], along[1][0])
     # Out of the margin: released.
     out = CollisionModel(costmap, (0.5, 0.0, 0.0), 1.0, 0.15, 0.05, True, held=model.held)
     assert not out.escaping and out.held is None

@@ -35,8 +35,14 @@ INSIDE_MARGIN_SLACK = 0.01
 #: may turn on the spot and get out, not slide along the obstacle nor come nearer.
 ESCAPE_GAIN = 0.5
 
-#: Float32 rounding allowed in that test (m).
+#: What a rollout getting out may fall short of :data:`ESCAPE_GAIN` by (m): sampled rollouts
+#: that turn away creep forward a little while they turn (a rollout may slide 2 mm along the
+#: obstacle; the robot, 4 cm/s at 20 Hz, at the same depth).
 ESCAPE_TOLERANCE = 0.001
+
+#: What a rollout getting out may come nearer than the robot is (m): rounding only (the start
+#: is measured at the pose rounded to float32, as the rollouts are).
+ESCAPE_ROUNDING = 1e-5
 
 
 def rollout_costs(costmap: Costmap2D, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -242,17 +248,20 @@ class CollisionModel:
             # Never below the radius once the disc overlaps an obstacle: held at its depth,
             # a robot slid along a pillar of the TurtleBot3 sandbox and, pressed against it,
             # drove on at 0.45 m/s, as each laser hit drawn a centimetre nearer lowered the
-            # hold again (to 0.06 m, with a 0.15 m radius). It may then only get out (a turn
-            # on the spot gains nothing and is allowed: it is never stuck for good).
+            # hold again (to 0.06 m, with a 0.15 m radius). It may then only get out, or turn
+            # on the spot (which gains nothing, and is allowed); in a gap narrower than its
+            # disc no move gets out, and it stays until the estimate or the map changes.
             if held is None or clearance < held:
-                self.held = max(inside, radius) if clearance < radius else max(inside, 0.0)
+                self.held = max(inside, 0.0)
             else:
                 self.held = held
-            self.threshold = self.held
             if clearance < radius:
+                self.held = max(self.held, radius)
                 self.escaping = True
-                start_at = float(self.field.at(np.float32([pose[0]]), np.float32([pose[1]]))[0])
-                self._start = (clearance, start_at)
+                px, py = np.float32([pose[0]]), np.float32([pose[1]])
+                self._start = (float(self.field.exact(px, py)[0]),
+                               float(self.field.at(px, py)[0]))
+            self.threshold = self.held
         else:
             self.threshold = limit
 
@@ -282,13 +291,15 @@ class CollisionModel:
                          start: float) -> np.ndarray:
         """Which poses of rollouts (the last axis: the steps, from the robot's pose) lie
         within the threshold with less than ``start`` (the robot's clearance) plus
-        :data:`ESCAPE_GAIN` times the distance driven to them."""
+        :data:`ESCAPE_GAIN` times the distance driven to them (less
+        :data:`ESCAPE_TOLERANCE`), or nearer than ``start`` at all."""
         x = np.asarray(x, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
         dx = np.diff(x, axis=-1, prepend=np.full(x.shape[:-1] + (1,), self._pose[0]))
         dy = np.diff(y, axis=-1, prepend=np.full(y.shape[:-1] + (1,), self._pose[1]))
         driven = np.cumsum(np.hypot(dx, dy), axis=-1)
-        needed = start + ESCAPE_GAIN * driven - ESCAPE_TOLERANCE
+        needed = np.maximum(start + ESCAPE_GAIN * driven - ESCAPE_TOLERANCE,
+                            start - ESCAPE_ROUNDING)
         return (clearance < self.threshold) & (clearance < needed)
 
     def _on_blocked_cells(self, x: np.ndarray, y: np.ndarray,
