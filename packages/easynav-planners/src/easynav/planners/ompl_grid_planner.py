@@ -507,13 +507,14 @@ class OMPLGridPlanner:
         ok, index = checker.polyline_free(poses[:, :2])
         approach = 0
         if ok and target != goal:
-            segment = self._approach_segment(target, goal)
+            segment = self._straight_segment(target, goal, goal[2])
+            segment[-1, 2] = goal[2]
             ok, index = self._body.polyline_free(segment[:, :2])
             index += len(poses) - 1
             poses = np.concatenate([poses[:-1], segment])
             approach = len(segment) - 1
         if ok and robot != start:
-            escape = self._escape_segment(robot, start)
+            escape = self._straight_segment(robot, start, robot[2])
             ok, index = self._body.polyline_free(escape[:, :2])
             poses = np.concatenate([escape[:-1], poses])
         if not ok:
@@ -526,27 +527,14 @@ class OMPLGridPlanner:
             )
         return PlanResult(poses=poses, approach=approach)
 
-    def _escape_segment(self, robot, start) -> np.ndarray:
-        """Poses from the robot to the escape point every ``interpolation_step``: facing along
-        the segment in SE2, keeping the robot's yaw for a car (it drives straight ahead or back)."""
-        if self.state_space == "SE2":
-            yaw = math.atan2(start[1] - robot[1], start[0] - robot[0])
-        else:
-            yaw = robot[2]
-        ends = np.array([[robot[0], robot[1], yaw], [start[0], start[1], yaw]])
+    def _straight_segment(self, a, b, car_yaw: float) -> np.ndarray:
+        """Poses from ``a`` to ``b`` every ``interpolation_step``: facing along the segment in
+        SE2, at ``car_yaw`` for a car (it drives straight ahead or back along its heading). The
+        escape from the robot keeps the robot's yaw; the approach to the goal, the goal's (and
+        in SE2 its last pose turns to it)."""
+        yaw = math.atan2(b[1] - a[1], b[0] - a[0]) if self.state_space == "SE2" else car_yaw
+        ends = np.array([[a[0], a[1], yaw], [b[0], b[1], yaw]])
         return densify(ends, self.interpolation_step)
-
-    def _approach_segment(self, target, goal) -> np.ndarray:
-        """Poses from the approach point to the goal every ``interpolation_step``: facing along
-        the segment in SE2 (the last has the goal's yaw), keeping the goal's yaw for a car (it
-        drives straight in along it, see :meth:`approach_point`)."""
-        yaw = goal[2]
-        if self.state_space == "SE2":
-            yaw = math.atan2(goal[1] - target[1], goal[0] - target[0])
-        ends = np.array([[target[0], target[1], yaw], [goal[0], goal[1], yaw]])
-        segment = densify(ends, self.interpolation_step)
-        segment[-1, 2] = goal[2]
-        return segment
 
     def _space(self, ob):
         if self.state_space == "SE2":
