@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from easynav.controllers.mppi.collision_model import clearance_reference
 from easynav.controllers.mppi.critics import CRITICS, DEFAULT_CRITICS
 from easynav.controllers.mppi.critics.cost_critic import rollout_costs
 from easynav.controllers.mppi.mppi_batch import MppiBatch
@@ -514,6 +515,65 @@ def test_follows_a_path_that_turns_round_a_pillar_between_pillars():
     assert states[-1] == "arrived"
     nearest = min(np.hypot(poses[:, 0] - px, poses[:, 1] - py).min() for px, py in pillars)
     assert nearest - 0.18 > 0.15  # the robot's disc never touched a pillar
+    assert_within_limits(commands, limits)
+
+
+#: Two pillars of the TurtleBot3 sandbox as its map has them (at (1.12, -0.03) and
+#: (1.12, 1.07)): per row of 0.05 m cells, the row's lower y and its first and last cell's
+#: lower x.
+SANDBOX_PILLARS = [
+    (-0.20, 1.00, 1.20), (-0.15, 1.00, 1.20), (-0.10, 0.95, 1.25), (-0.05, 0.95, 1.25),
+    (0.00, 0.95, 1.25), (0.05, 0.95, 1.20), (0.10, 1.00, 1.15),
+    (0.90, 1.05, 1.20), (0.95, 1.00, 1.25), (1.00, 1.00, 1.25), (1.05, 1.00, 1.30),
+    (1.10, 1.00, 1.25), (1.15, 1.00, 1.25), (1.20, 1.05, 1.15),
+]
+
+
+#: OMPL's path in that run, from the waypoint (1.8, 0) to the next one (0.55, -1.65).
+SANDBOX_PATH = np.array([
+    (1.795, 0.037), (1.756, 0.126), (1.717, 0.216), (1.668, 0.3), (1.606, 0.375), (1.535, 0.443),
+    (1.453, 0.492), (1.358, 0.512), (1.26, 0.52), (1.162, 0.524), (1.064, 0.526), (0.967, 0.53),
+    (0.869, 0.531), (0.775, 0.515), (0.69, 0.467), (0.623, 0.396), (0.589, 0.305), (0.578, 0.208),
+    (0.576, 0.11), (0.575, 0.012), (0.575, -0.085), (0.575, -0.183), (0.575, -0.281),
+    (0.575, -0.379), (0.575, -0.477), (0.573, -0.575), (0.57, -0.673), (0.567, -0.77),
+    (0.565, -0.868), (0.569, -0.966), (0.573, -1.064), (0.571, -1.162), (0.563, -1.259),
+    (0.555, -1.356), (0.551, -1.454), (0.551, -1.552), (0.55, -1.65),
+])
+
+
+def test_stuck_at_the_margin_of_a_bend_inside_it_turns_to_a_free_heading():
+    # The TurtleBot3 sandbox with the simple maps manager (its map as lethal cells only):
+    # OMPL's path from a waypoint east of the passage between two pillars goes north, then
+    # west through the passage. MPPI, handed over by the rotation to the path's heading 45
+    # degrees off the path, cut the bend and ended at the collision margin of the southern
+    # pillar, facing it: every sample that drives ahead collides, every one that turns first
+    # ends as far from the path ahead as standing, and the softmin mean stood there for good
+    # (on the sandbox, with AMCL's noise, it crept into the pillar). Making no progress, it
+    # turns on the spot to the free heading nearest the path ahead.
+    costmap = Costmap2D.filled(160, 120, 0.05, -1.0, -2.5)
+    for y, x0, x1 in SANDBOX_PILLARS:
+        i0, j = (int(v) for v in costmap.world_to_cell(x0 + 0.025, y + 0.025))
+        i1, _ = (int(v) for v in costmap.world_to_cell(x1 + 0.025, y + 0.025))
+        costmap.data[j, i0 : i1 + 1] = LETHAL_OBSTACLE
+    xy = SANDBOX_PATH
+    yaw = np.arctan2(np.diff(xy[:, 1], append=xy[-1, 1]), np.diff(xy[:, 0], append=xy[-1, 0]))
+    yaw[-1] = yaw[-2]
+    limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0,
+                         max_linear_acc=0.5, max_linear_decel=1.0, max_angular_acc=1.0,
+                         max_angular_decel=2.0)
+    controller = make_controller(NAV2_SIZE, limits=limits, radius=0.15)
+    nav_state = NavState()
+    nav_state.set("map", costmap)
+    nav_state.set("goal_tolerance.position", 0.15)
+    nav_state.set("goal_tolerance.yaw", 0.3)
+    # At the waypoint, facing south (the way it came).
+    poses, commands, states = run_closed_loop(controller, np.column_stack((xy, yaw)),
+                                              (1.774, 0.032, -1.435), steps=600,
+                                              nav_state=nav_state)
+    assert states[-1] == "arrived"
+    assert "turning_to_free_heading" in states
+    to_pillars = [clearance_reference(costmap, x, y, True) for x, y, _ in poses]
+    assert min(to_pillars) > 0.15  # the robot's disc never touched a pillar
     assert_within_limits(commands, limits)
 
 

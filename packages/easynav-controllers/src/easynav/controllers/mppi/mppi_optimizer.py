@@ -105,7 +105,24 @@ ROTATING_TO_GOAL = "rotating_to_goal"
 #: Turned at the goal but beyond its position tolerance: straight along the heading.
 CREEPING_TO_GOAL = "creeping_to_goal"
 ROTATING_TO_HEADING = "rotating_to_heading"
+#: The optimal sequence made no progress: turning in place to the free heading nearest the
+#: path ahead (see :data:`STUCK_SPEED_RATIO`).
+TURNING_TO_FREE_HEADING = "turning_to_free_heading"
 ARRIVED = "arrived"
+
+#: Mean speed over the horizon, as a share of ``max_linear_vel``, below which the optimal
+#: sequence makes no progress. A robot that cut a bend's corner into the collision margin of
+#: the obstacle inside it, facing the obstacle, finds every sample that drives ahead colliding
+#: and every one that turns first costing the same as standing (the path critics measure
+#: where the rollouts end): the softmin mean stands, and on the TurtleBot3 sandbox, at a
+#: pillar beside a passage, it stood there for good (crept, with AMCL's noise, into the pillar).
+STUCK_SPEED_RATIO = 0.1
+#: Headings tried for a free one (every 5 degrees), and how far straight ahead each must be
+#: clear (m) to count as free.
+FREE_HEADINGS = 72
+FREE_HEADING_DISTANCE = 0.3
+#: Heading error (rad) at which the turn to a free heading hands back to the optimisation.
+FREE_HEADING_TOLERANCE = 0.1
 
 #: Arc length (m) of the path kept ahead of the rollouts' reach.
 PATH_MARGIN = 1.0
@@ -166,7 +183,9 @@ class MppiOptimizer:
     obstacle within ``robot_radius`` + ``CostCritic.collision_margin``, or as near as the path
     goes) within the braking time from full speed plus :data:`GUARD_REACTION`: then the best
     sample's (state ``fallback``), and when that collides too the robot brakes, and once
-    stopped turns on the spot towards the path ahead (state ``blocked``).
+    stopped turns on the spot towards the path ahead (state ``blocked``). When the applied
+    sequence makes no progress (:data:`STUCK_SPEED_RATIO`) the robot brakes and turns on the
+    spot to the free heading nearest the path ahead (state ``turning_to_free_heading``).
     Inside the goal's xy tolerance it rotates in place to the goal yaw and stops within the yaw
     tolerance.
 
@@ -215,6 +234,7 @@ class MppiOptimizer:
         self._rotating = False
         self._rotation_sign = 0.0
         self._blocked_sign = 0.0  # the latch of the turn in place when blocked
+        self._free_heading: float | None = None  # the yaw turned to when no progress
         self._held: float | None = None  # the CollisionModel's hold inside the margin
         self.last_batch: MppiBatch | None = None
 
@@ -309,6 +329,13 @@ class MppiOptimizer:
                 return self._apply(0.0, w, ROTATING_TO_HEADING)
         self._rotating = False
         self._rotation_sign = 0.0
+        if self._free_heading is not None:
+            error = normalize_angle(self._free_heading - yaw0)
+            if abs(error) > FREE_HEADING_TOLERANCE:
+                w = rotation_speed(error, self.last[1], elapsed, max_w, limits.max_angular_acc,
+                                   limits.max_angular_decel, max_w)
+                return self._apply(0.0, w, TURNING_TO_FREE_HEADING)
+            self._free_heading = None
 
         # Warm start: the previous optimal sequence, shifted by the time elapsed.
         shift = min(max(int(round(elapsed / dt)), 0), steps)
@@ -408,9 +435,26 @@ class MppiOptimizer:
             state = FALLBACK
         else:
             self._blocked_sign = 0.0
+        self.last_batch = batch
+        if (collision is not None and batch.remaining > xy_tolerance + FREE_HEADING_DISTANCE
+                and float(np.abs(v_seq[0]).mean()) < STUCK_SPEED_RATIO * max_v):
+            heading = self._free_heading_towards_path(pose, path_xy, path_yaw, path_s, collision)
+            if heading is not None and abs(normalize_angle(heading - yaw0)) > (
+                    FREE_HEADING_TOLERANCE):
+                # Brake first: the turn in place starts from a standstill.
+                v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
+                    self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
+                                                 * elapsed)
+                self.sequence[:] = 0.0
+                if v != 0.0:
+                    return self._apply(v, 0.0, TURNING_TO_FREE_HEADING)
+                self._free_heading = heading
+                error = normalize_angle(heading - yaw0)
+                w = rotation_speed(error, self.last[1], elapsed, max_w, limits.max_angular_acc,
+                                   limits.max_angular_decel, max_w)
+                return self._apply(0.0, w, TURNING_TO_FREE_HEADING)
         self.sequence[:, 0] = v_seq[0]
         self.sequence[:, 1] = w_seq[0]
-        self.last_batch = batch
         optimal = np.column_stack((ox[0], oy[0], oyaw[0]))
         return self._apply(float(v_seq[0, 0]), float(w_seq[0, 0]), state, optimal)
 
@@ -425,6 +469,26 @@ class MppiOptimizer:
         if math.hypot(tx - x0, ty - y0) > 1e-3:
             return normalize_angle(math.atan2(ty - y0, tx - x0) - yaw0), True
         return normalize_angle(path_yaw[0] - yaw0), False
+
+    def _free_heading_towards_path(self, pose, path_xy, path_yaw, path_s,
+                                   collision: CollisionModel) -> float | None:
+        """The heading nearest the direction to the path point
+        ``rotate_to_heading_lookahead_dist`` ahead along which the robot can drive
+        :data:`FREE_HEADING_DISTANCE` straight without colliding (``collision``), tried every
+        ``2π / FREE_HEADINGS``; None when none is free."""
+        x0, y0, yaw0 = pose
+        angle, _far = self._angle_to_path_ahead(pose, path_xy, path_yaw, path_s)
+        wanted = yaw0 + angle
+        offsets = np.arange(FREE_HEADINGS // 2 + 1) * (2.0 * math.pi / FREE_HEADINGS)
+        along = np.linspace(0.0, FREE_HEADING_DISTANCE, 13)[1:]
+        for offset in offsets:
+            for sign in ((1.0,) if offset in (0.0, math.pi) else (1.0, -1.0)):
+                heading = wanted + sign * offset
+                x = (x0 + along * math.cos(heading)).astype(np.float32)
+                y = (y0 + along * math.sin(heading)).astype(np.float32)
+                if not collision.rollout_collides(x, y):
+                    return normalize_angle(heading)
+        return None
 
     def _latch(self, angle: float) -> float:
         # Keep turning the way a rotation in place started while the target is near ±π.
