@@ -105,24 +105,28 @@ ROTATING_TO_GOAL = "rotating_to_goal"
 #: Turned at the goal but beyond its position tolerance: straight along the heading.
 CREEPING_TO_GOAL = "creeping_to_goal"
 ROTATING_TO_HEADING = "rotating_to_heading"
-#: The optimal sequence made no progress: turning in place to the free heading nearest the
+#: Stuck facing an obstacle: braking, then turning in place to the free heading nearest the
 #: path ahead (see :data:`STUCK_SPEED_RATIO`).
 TURNING_TO_FREE_HEADING = "turning_to_free_heading"
 ARRIVED = "arrived"
 
-#: Mean speed over the horizon, as a share of ``max_linear_vel``, below which the optimal
-#: sequence makes no progress. A robot that cut a bend's corner into the collision margin of
-#: the obstacle inside it, facing the obstacle, finds every sample that drives ahead colliding
-#: and every one that turns first costing the same as standing (the path critics measure
-#: where the rollouts end): the softmin mean stands, and on the TurtleBot3 sandbox, at a
-#: pillar beside a passage, it stood there for good (crept, with AMCL's noise, into the pillar).
+#: Stuck: for :data:`STUCK_TIME` the applied sequence's mean speed over the horizon stayed
+#: below this share of ``max_linear_vel`` while driving :data:`FREE_HEADING_DISTANCE` straight
+#: ahead would collide. A robot that cut a bend's corner into the collision margin of the
+#: obstacle inside it, facing the obstacle, finds every sample that drives ahead colliding and
+#: every one that turns first costing the same as standing (the path critics measure where the
+#: rollouts end): the softmin mean stands, and on the TurtleBot3 sandbox, at a pillar beside a
+#: passage, it stood there for good (crept, with AMCL's noise, into the pillar).
 STUCK_SPEED_RATIO = 0.1
+#: How long (s) the robot must be stuck before it turns: a planned stop (a person stepping in
+#: ahead) is slow for a moment, a stuck robot for good.
+STUCK_TIME = 1.0
 #: Headings tried for a free one (every 5 degrees), and how far straight ahead each must be
 #: clear (m) to count as free.
 FREE_HEADINGS = 72
 FREE_HEADING_DISTANCE = 0.3
 #: Heading error (rad) at which the turn to a free heading hands back to the optimisation.
-FREE_HEADING_TOLERANCE = 0.1
+FREE_HEADING_TOLERANCE = 0.05
 
 #: Arc length (m) of the path kept ahead of the rollouts' reach.
 PATH_MARGIN = 1.0
@@ -234,7 +238,7 @@ class MppiOptimizer:
         self._rotating = False
         self._rotation_sign = 0.0
         self._blocked_sign = 0.0  # the latch of the turn in place when blocked
-        self._free_heading: float | None = None  # the yaw turned to when no progress
+        self._forget_free_heading()
         self._held: float | None = None  # the CollisionModel's hold inside the margin
         self.last_batch: MppiBatch | None = None
 
@@ -287,6 +291,7 @@ class MppiOptimizer:
             lengths = np.hypot(*np.diff(self._path[:, :2], axis=0).T)
             self._s = np.concatenate(([0.0], np.cumsum(lengths)))
             self._segment = -1
+            self._forget_free_heading()
         x0, y0, yaw0 = pose
         dt = p["dt"]
         max_v = max(limits.max_linear_vel, 0.0)
@@ -300,6 +305,7 @@ class MppiOptimizer:
                                      can_reverse=limits.min_linear_vel < 0.0)
         if action is not None:
             self.sequence[:] = 0.0
+            self._forget_free_heading()
             kind, value = action
             if kind == TURN:
                 if not was_turning:  # a new turn: not the way a turn to the path went
@@ -322,6 +328,7 @@ class MppiOptimizer:
             threshold = p["rotate_to_heading_min_angle"] * (0.5 if self._rotating else 1.0)
             if far and abs(angle) > threshold:
                 self._rotating = True
+                self._forget_free_heading()
                 angle = self._latch(angle)
                 self.sequence[:] = 0.0
                 w = rotation_speed(angle, self.last[1], elapsed, max_w, limits.max_angular_acc,
@@ -330,12 +337,21 @@ class MppiOptimizer:
         self._rotating = False
         self._rotation_sign = 0.0
         if self._free_heading is not None:
-            error = normalize_angle(self._free_heading - yaw0)
+            if self.last[0] != 0.0:
+                # Braking first, and easing any turn: the turn in place starts from a standstill.
+                v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
+                    self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
+                                                 * elapsed)
+                w = math.copysign(max(0.0, abs(self.last[1]) - limits.max_angular_decel
+                                      * elapsed), self.last[1])
+                return self._apply(v, w, TURNING_TO_FREE_HEADING)
+            error = latched_angle(normalize_angle(self._free_heading - yaw0), self._free_sign)
+            self._free_sign = 1.0 if error >= 0.0 else -1.0
             if abs(error) > FREE_HEADING_TOLERANCE:
                 w = rotation_speed(error, self.last[1], elapsed, max_w, limits.max_angular_acc,
                                    limits.max_angular_decel, max_w)
                 return self._apply(0.0, w, TURNING_TO_FREE_HEADING)
-            self._free_heading = None
+            self._forget_free_heading()  # there: optimise again, from a cold start
 
         # Warm start: the previous optimal sequence, shifted by the time elapsed.
         shift = min(max(int(round(elapsed / dt)), 0), steps)
@@ -354,9 +370,11 @@ class MppiOptimizer:
         # are held within the accelerations from the current command below.
         sample_bounds = bounds[:3] + (math.inf,) * 4
         std = np.array((p["vx_std"], p["wz_std"]), dtype=np.float32)
+        # (Reaching at least as far as a free heading is checked, when the limits are low.)
         collision = None if costmap is None else CollisionModel(
-            costmap, pose, rollout_reach, robot_radius, p["CostCritic.collision_margin"],
-            p["CostCritic.consider_unknown_lethal"], path_xy, self._held)
+            costmap, pose, max(rollout_reach, FREE_HEADING_DISTANCE), robot_radius,
+            p["CostCritic.collision_margin"], p["CostCritic.consider_unknown_lethal"], path_xy,
+            self._held)
         self._held = None if collision is None else collision.held
         batch = None
         for _ in range(p["iteration_count"]):
@@ -436,23 +454,19 @@ class MppiOptimizer:
         else:
             self._blocked_sign = 0.0
         self.last_batch = batch
-        if (collision is not None and batch.remaining > xy_tolerance + FREE_HEADING_DISTANCE
-                and float(np.abs(v_seq[0]).mean()) < STUCK_SPEED_RATIO * max_v):
+        if self._stuck(pose, v_seq[0], max_v, elapsed, collision, batch.remaining,
+                       xy_tolerance):
             heading = self._free_heading_towards_path(pose, path_xy, path_yaw, path_s, collision)
             if heading is not None and abs(normalize_angle(heading - yaw0)) > (
                     FREE_HEADING_TOLERANCE):
-                # Brake first: the turn in place starts from a standstill.
+                self._free_heading = heading
+                self.sequence[:] = 0.0
                 v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
                     self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
                                                  * elapsed)
-                self.sequence[:] = 0.0
-                if v != 0.0:
-                    return self._apply(v, 0.0, TURNING_TO_FREE_HEADING)
-                self._free_heading = heading
-                error = normalize_angle(heading - yaw0)
-                w = rotation_speed(error, self.last[1], elapsed, max_w, limits.max_angular_acc,
-                                   limits.max_angular_decel, max_w)
-                return self._apply(0.0, w, TURNING_TO_FREE_HEADING)
+                w = math.copysign(max(0.0, abs(self.last[1]) - limits.max_angular_decel
+                                      * elapsed), self.last[1])
+                return self._apply(v, w, TURNING_TO_FREE_HEADING)
         self.sequence[:, 0] = v_seq[0]
         self.sequence[:, 1] = w_seq[0]
         optimal = np.column_stack((ox[0], oy[0], oyaw[0]))
@@ -470,23 +484,56 @@ class MppiOptimizer:
             return normalize_angle(math.atan2(ty - y0, tx - x0) - yaw0), True
         return normalize_angle(path_yaw[0] - yaw0), False
 
+    def _forget_free_heading(self) -> None:
+        self._free_heading: float | None = None  # the yaw turned to when stuck
+        self._free_sign = 0.0  # the latch of that turn near ±pi
+        self._stuck_time = 0.0  # how long the robot has been stuck (s)
+
+    @staticmethod
+    def _straight_collides(pose, heading: float, collision: CollisionModel) -> bool:
+        """Whether driving :data:`FREE_HEADING_DISTANCE` straight along ``heading`` from
+        ``pose`` collides (``collision``)."""
+        along = np.linspace(0.0, FREE_HEADING_DISTANCE, 13)[1:]
+        x = (pose[0] + along * math.cos(heading)).astype(np.float32)
+        y = (pose[1] + along * math.sin(heading)).astype(np.float32)
+        return collision.rollout_collides(x, y)
+
+    def _stuck(self, pose, v_seq: np.ndarray, max_v: float, elapsed: float,
+               collision: CollisionModel | None, remaining: float, xy_tolerance: float) -> bool:
+        """Whether the robot has been stuck for :data:`STUCK_TIME` (see
+        :data:`STUCK_SPEED_RATIO`), counting this cycle; not near the goal, where a robot
+        slows down on purpose."""
+        if (collision is None or remaining <= xy_tolerance + FREE_HEADING_DISTANCE
+                or float(np.abs(v_seq).mean()) >= STUCK_SPEED_RATIO * max_v
+                or not self._straight_collides(pose, pose[2], collision)):
+            self._stuck_time = 0.0
+            return False
+        self._stuck_time += elapsed
+        return self._stuck_time >= STUCK_TIME
+
     def _free_heading_towards_path(self, pose, path_xy, path_yaw, path_s,
                                    collision: CollisionModel) -> float | None:
         """The heading nearest the direction to the path point
         ``rotate_to_heading_lookahead_dist`` ahead along which the robot can drive
         :data:`FREE_HEADING_DISTANCE` straight without colliding (``collision``), tried every
-        ``2π / FREE_HEADINGS``; None when none is free."""
-        x0, y0, yaw0 = pose
+        ``2π / FREE_HEADINGS``, on the side the robot faces first at equal angles; None when
+        none is free. With ``use_rotate_to_heading``, only headings the rotation to the path's
+        heading would not turn the robot back from (within ``rotate_to_heading_min_angle``,
+        less twice :data:`FREE_HEADING_TOLERANCE`): with one it would, in a corner, the two
+        would turn the robot back and forth for good."""
         angle, _far = self._angle_to_path_ahead(pose, path_xy, path_yaw, path_s)
-        wanted = yaw0 + angle
-        offsets = np.arange(FREE_HEADINGS // 2 + 1) * (2.0 * math.pi / FREE_HEADINGS)
-        along = np.linspace(0.0, FREE_HEADING_DISTANCE, 13)[1:]
-        for offset in offsets:
-            for sign in ((1.0,) if offset in (0.0, math.pi) else (1.0, -1.0)):
-                heading = wanted + sign * offset
-                x = (x0 + along * math.cos(heading)).astype(np.float32)
-                y = (y0 + along * math.sin(heading)).astype(np.float32)
-                if not collision.rollout_collides(x, y):
+        wanted = pose[2] + angle
+        widest = math.pi
+        if self.params["use_rotate_to_heading"]:
+            widest = self.params["rotate_to_heading_min_angle"] - 2.0 * FREE_HEADING_TOLERANCE
+        toward_yaw = -1.0 if angle > 0.0 else 1.0  # the robot's heading is on this side
+        step = 2.0 * math.pi / FREE_HEADINGS
+        for k in range(FREE_HEADINGS // 2 + 1):
+            if k * step > widest:
+                break
+            for sign in (toward_yaw, -toward_yaw) if 0 < k < FREE_HEADINGS // 2 else (1.0,):
+                heading = wanted + sign * k * step
+                if not self._straight_collides(pose, heading, collision):
                     return normalize_angle(heading)
         return None
 
