@@ -79,12 +79,17 @@ def arc_path(radius=1.5, angle=math.pi / 2, step=0.05):
     return np.column_stack((radius * np.sin(a), radius * (1.0 - np.cos(a)), a))
 
 
-def run_closed_loop(controller, path_xy_yaw, start, steps=800, dt=0.05, nav_state=None):
+def run_closed_loop(controller, path_xy_yaw, start, steps=800, dt=0.05, nav_state=None,
+                    replan_every=0):
+    """Drive a unicycle; with ``replan_every``, a new Path object (the same poses) is set every
+    that many cycles, as a planner that replans continuously does."""
     nav_state = nav_state or NavState()
     nav_state.set("path", Path.from_xy_yaw(path_xy_yaw, Header(0.0, "map")))
     x, y, yaw = start
     poses, commands, states = [], [], []
-    for _ in range(steps):
+    for step in range(steps):
+        if replan_every and step and step % replan_every == 0:
+            nav_state.set("path", Path.from_xy_yaw(path_xy_yaw, Header(0.0, "map")))
         nav_state.set("robot_pose", Odometry(Header(0.0, "map"), "base_footprint",
                                              Pose.from_xy_yaw(x, y, yaw)))
         controller.update_rt(nav_state)
@@ -542,7 +547,8 @@ SANDBOX_PATH = np.array([
 ])
 
 
-def test_stuck_at_the_margin_of_a_bend_inside_it_turns_to_a_free_heading():
+@pytest.mark.parametrize("replan_every", [0, 10], ids=["one_path", "replanned"])
+def test_stuck_at_the_margin_of_a_bend_inside_it_turns_to_a_free_heading(replan_every):
     # The TurtleBot3 sandbox with the simple maps manager (its map as lethal cells only):
     # OMPL's path from a waypoint east of the passage between two pillars goes north, then
     # west through the passage. MPPI, handed over by the rotation to the path's heading 45
@@ -550,7 +556,8 @@ def test_stuck_at_the_margin_of_a_bend_inside_it_turns_to_a_free_heading():
     # pillar, facing it: every sample that drives ahead collides, every one that turns first
     # ends as far from the path ahead as standing, and the softmin mean stood there for good
     # (on the sandbox, with AMCL's noise, it crept into the pillar). Making no progress, it
-    # turns on the spot to the free heading nearest the path ahead.
+    # turns on the spot to the free heading nearest the path ahead; also when the path is
+    # replanned (the same path, a new object) every half second, as the costmap planner does.
     costmap = Costmap2D.filled(160, 120, 0.05, -1.0, -2.5)
     for y, x0, x1 in SANDBOX_PILLARS:
         i0, j = (int(v) for v in costmap.world_to_cell(x0 + 0.025, y + 0.025))
@@ -570,7 +577,7 @@ def test_stuck_at_the_margin_of_a_bend_inside_it_turns_to_a_free_heading():
     # At the waypoint, facing south (the way it came).
     poses, commands, states = run_closed_loop(controller, np.column_stack((xy, yaw)),
                                               (1.774, 0.032, -1.435), steps=600,
-                                              nav_state=nav_state)
+                                              nav_state=nav_state, replan_every=replan_every)
     assert states[-1] == "arrived"
     to_pillars = np.array([clearance_reference(costmap, x, y, True) for x, y, _ in poses]) - 0.15
     assert to_pillars.min() > 0.0  # the robot's disc never touched a pillar

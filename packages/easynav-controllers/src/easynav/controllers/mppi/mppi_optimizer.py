@@ -187,9 +187,12 @@ class MppiOptimizer:
     obstacle within ``robot_radius`` + ``CostCritic.collision_margin``, or as near as the path
     goes) within the braking time from full speed plus :data:`GUARD_REACTION`: then the best
     sample's (state ``fallback``), and when that collides too the robot brakes, and once
-    stopped turns on the spot towards the path ahead (state ``blocked``). When the applied
-    sequence makes no progress (:data:`STUCK_SPEED_RATIO`) the robot brakes and turns on the
-    spot to the free heading nearest the path ahead (state ``turning_to_free_heading``).
+    stopped turns on the spot towards the path ahead (state ``blocked``). Stuck facing an
+    obstacle (for :data:`STUCK_TIME` slow, :data:`STUCK_SPEED_RATIO`, while driving
+    :data:`FREE_HEADING_DISTANCE` straight ahead would collide; not near the goal), the robot
+    brakes and turns on the spot to the free heading nearest the path ahead (state
+    ``turning_to_free_heading``); a new goal, the goal's approach or the rotation to the path's
+    heading cancel that turn.
     Inside the goal's xy tolerance it rotates in place to the goal yaw and stops within the yaw
     tolerance.
 
@@ -286,12 +289,17 @@ class MppiOptimizer:
         key = path_key if path_key is not None else id(path_xy_yaw)
         # Identity for path objects (a Path compares its poses field by field); value for ints.
         if not (key is self._path_key or (type(key) is int and key == self._path_key)):
+            old_goal = self._path[-1] if len(self._path) else None
             self._path_key = key
             self._path = densify_path(path_xy_yaw)
             lengths = np.hypot(*np.diff(self._path[:, :2], axis=0).T)
             self._s = np.concatenate(([0.0], np.cumsum(lengths)))
             self._segment = -1
-            self._forget_free_heading()
+            # A new goal cancels a turn to a free heading; a replanned path to the same goal
+            # does not (the costmap and NavMap planners plan anew each cycle by default: the
+            # robot would never count as stuck for a second).
+            if old_goal is None or not np.allclose(old_goal, self._path[-1], atol=1e-3):
+                self._forget_free_heading()
         x0, y0, yaw0 = pose
         dt = p["dt"]
         max_v = max(limits.max_linear_vel, 0.0)
@@ -448,6 +456,7 @@ class MppiOptimizer:
                     self._blocked_sign = 1.0 if angle >= 0.0 else -1.0
                     w = rotation_speed(angle, self.last[1], elapsed, max_w,
                                        limits.max_angular_acc, limits.max_angular_decel, max_w)
+                self._stuck_time = 0.0  # blocked has its own turn
                 return self._apply(v, w, BLOCKED)
             self._blocked_sign = 0.0
             state = FALLBACK
@@ -457,6 +466,7 @@ class MppiOptimizer:
         if self._stuck(pose, v_seq[0], max_v, elapsed, collision, batch.remaining,
                        xy_tolerance):
             heading = self._free_heading_towards_path(pose, path_xy, path_yaw, path_s, collision)
+            self._stuck_time = 0.0  # no turn found: look again after another second
             if heading is not None and abs(normalize_angle(heading - yaw0)) > (
                     FREE_HEADING_TOLERANCE):
                 self._free_heading = heading
