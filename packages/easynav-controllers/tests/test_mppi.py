@@ -492,6 +492,31 @@ def test_a_rollout_cutting_across_a_bend_does_not_reach_the_path_beyond_it():
     assert both.furthest_reached_index() == 7
 
 
+#: The TurtleBot3 sandbox's limits (its params files).
+SANDBOX_LIMITS = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0,
+                             max_linear_acc=0.5, max_linear_decel=1.0, max_angular_acc=1.0,
+                             max_angular_decel=2.0)
+
+
+def sandbox_controller(costmap):
+    """A Nav2-sized MPPI for the sandbox's 0.15 m robot over ``costmap``, and its NavState (the
+    map, the goal tolerances of the params files)."""
+    controller = make_controller(NAV2_SIZE, limits=SANDBOX_LIMITS, radius=0.15)
+    nav_state = NavState()
+    nav_state.set("map", costmap)
+    nav_state.set("goal_tolerance.position", 0.15)
+    nav_state.set("goal_tolerance.yaw", 0.3)
+    return controller, nav_state
+
+
+def with_segment_yaw(xy, last_yaw=None):
+    """The points ``xy`` with the yaw of the segment each starts (the last: ``last_yaw``, or
+    the last segment's)."""
+    yaw = np.arctan2(np.diff(xy[:, 1], append=xy[-1, 1]), np.diff(xy[:, 0], append=xy[-1, 0]))
+    yaw[-1] = yaw[-2] if last_yaw is None else last_yaw
+    return np.column_stack((xy, yaw))
+
+
 def test_follows_a_path_that_turns_round_a_pillar_between_pillars():
     # The TurtleBot3 sandbox's pillars (radius 0.18 m, 1.1 m apart, 0.74 m passages) and a
     # path that leaves a passage round the pillar ahead on its left: west between two rows,
@@ -504,24 +529,15 @@ def test_follows_a_path_that_turns_round_a_pillar_between_pillars():
     pieces = [np.linspace(a, b, max(2, int(np.hypot(*(b - a)) / 0.05)))[:-1]
               for a, b in zip(corners[:-1], corners[1:], strict=True)]
     xy = np.vstack(pieces + [corners[-1:]])
-    yaw = np.arctan2(np.diff(xy[:, 1], append=xy[-1, 1]), np.diff(xy[:, 0], append=xy[-1, 0]))
-    yaw[-1] = 0.0
-    limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0,
-                         max_linear_acc=0.5, max_linear_decel=1.0, max_angular_acc=1.0,
-                         max_angular_decel=2.0)
-    controller = make_controller(NAV2_SIZE, limits=limits, radius=0.15)
-    nav_state = NavState()
-    nav_state.set("map", costmap)
-    nav_state.set("goal_tolerance.position", 0.15)
-    nav_state.set("goal_tolerance.yaw", 0.3)
-    poses, commands, states = run_closed_loop(controller, np.column_stack((xy, yaw)),
+    controller, nav_state = sandbox_controller(costmap)
+    poses, commands, states = run_closed_loop(controller, with_segment_yaw(xy, 0.0),
                                               (2.8, -0.55, math.pi), steps=1200,
                                               nav_state=nav_state)
     assert states[-1] == "arrived"
     assert "turning_to_free_heading" not in states  # never stuck on the way
     nearest = min(np.hypot(poses[:, 0] - px, poses[:, 1] - py).min() for px, py in pillars)
     assert nearest - 0.18 > 0.15  # the robot's disc never touched a pillar
-    assert_within_limits(commands, limits)
+    assert_within_limits(commands, SANDBOX_LIMITS)
 
 
 #: Two pillars of the TurtleBot3 sandbox as its map has them (at (1.12, -0.03) and
@@ -563,19 +579,9 @@ def test_stuck_at_the_margin_of_a_bend_inside_it_turns_to_a_free_heading(replan_
         i0, j = (int(v) for v in costmap.world_to_cell(x0 + 0.025, y + 0.025))
         i1, _ = (int(v) for v in costmap.world_to_cell(x1 + 0.025, y + 0.025))
         costmap.data[j, i0 : i1 + 1] = LETHAL_OBSTACLE
-    xy = SANDBOX_PATH
-    yaw = np.arctan2(np.diff(xy[:, 1], append=xy[-1, 1]), np.diff(xy[:, 0], append=xy[-1, 0]))
-    yaw[-1] = yaw[-2]
-    limits = RobotLimits(max_linear_vel=0.5, min_linear_vel=0.0, max_angular_vel=1.0,
-                         max_linear_acc=0.5, max_linear_decel=1.0, max_angular_acc=1.0,
-                         max_angular_decel=2.0)
-    controller = make_controller(NAV2_SIZE, limits=limits, radius=0.15)
-    nav_state = NavState()
-    nav_state.set("map", costmap)
-    nav_state.set("goal_tolerance.position", 0.15)
-    nav_state.set("goal_tolerance.yaw", 0.3)
+    controller, nav_state = sandbox_controller(costmap)
     # At the waypoint, facing south (the way it came).
-    poses, commands, states = run_closed_loop(controller, np.column_stack((xy, yaw)),
+    poses, commands, states = run_closed_loop(controller, with_segment_yaw(SANDBOX_PATH),
                                               (1.774, 0.032, -1.435), steps=600,
                                               nav_state=nav_state, replan_every=replan_every)
     assert states[-1] == "arrived"
@@ -587,7 +593,7 @@ def test_stuck_at_the_margin_of_a_bend_inside_it_turns_to_a_free_heading(replan_
     first = int(np.argmax(turning))
     assert to_pillars[first] < 0.05 + 0.025 and poses[first, 1] < 0.35
     assert abs(normalize_angle(poses[first, 2] - math.pi)) < 0.4
-    assert_within_limits(commands, limits)
+    assert_within_limits(commands, SANDBOX_LIMITS)
 
 
 def u_turn_path(step=0.05):
