@@ -353,8 +353,10 @@ class MppiOptimizer:
                 w = math.copysign(max(0.0, abs(self.last[1]) - limits.max_angular_decel
                                       * elapsed), self.last[1])
                 return self._apply(v, w, TURNING_TO_FREE_HEADING)
-            error = latched_angle(normalize_angle(self._free_heading - yaw0), self._free_sign)
-            self._free_sign = 1.0 if error >= 0.0 else -1.0
+            # Through the path's direction (where the search started), never round the back:
+            # the rotation to the path's heading would take over there and turn it back.
+            error = (normalize_angle(self._free_heading - self._free_reference)
+                     - normalize_angle(yaw0 - self._free_reference))
             if abs(error) > FREE_HEADING_TOLERANCE:
                 w = rotation_speed(error, self.last[1], elapsed, max_w, limits.max_angular_acc,
                                    limits.max_angular_decel, max_w)
@@ -465,11 +467,11 @@ class MppiOptimizer:
         self.last_batch = batch
         if self._stuck(pose, v_seq[0], max_v, elapsed, collision, batch.remaining,
                        xy_tolerance):
-            heading = self._free_heading_towards_path(pose, path_xy, path_yaw, path_s, collision)
+            found = self._free_heading_towards_path(pose, path_xy, path_yaw, path_s, collision)
             self._stuck_time = 0.0  # no turn found: look again after another second
-            if heading is not None and abs(normalize_angle(heading - yaw0)) > (
+            if found is not None and abs(normalize_angle(found[0] - yaw0)) > (
                     FREE_HEADING_TOLERANCE):
-                self._free_heading = heading
+                self._free_heading, self._free_reference = found
                 self.sequence[:] = 0.0
                 v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
                     self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
@@ -496,7 +498,7 @@ class MppiOptimizer:
 
     def _forget_free_heading(self) -> None:
         self._free_heading: float | None = None  # the yaw turned to when stuck
-        self._free_sign = 0.0  # the latch of that turn near ±pi
+        self._free_reference = 0.0  # the path's direction it turns through
         self._stuck_time = 0.0  # how long the robot has been stuck (s)
 
     @staticmethod
@@ -522,15 +524,15 @@ class MppiOptimizer:
         return self._stuck_time >= STUCK_TIME
 
     def _free_heading_towards_path(self, pose, path_xy, path_yaw, path_s,
-                                   collision: CollisionModel) -> float | None:
+                                   collision: CollisionModel) -> tuple[float, float] | None:
         """The heading nearest the direction to the path point
         ``rotate_to_heading_lookahead_dist`` ahead along which the robot can drive
         :data:`FREE_HEADING_DISTANCE` straight without colliding (``collision``), tried every
-        ``2π / FREE_HEADINGS``, on the side the robot faces first at equal angles; None when
-        none is free. With ``use_rotate_to_heading``, only headings the rotation to the path's
-        heading would not turn the robot back from (within ``rotate_to_heading_min_angle``,
-        less twice :data:`FREE_HEADING_TOLERANCE`): with one it would, in a corner, the two
-        would turn the robot back and forth for good."""
+        ``2π / FREE_HEADINGS``, on the side the robot faces first at equal angles, and that
+        direction; None when none is free. With ``use_rotate_to_heading``, only headings the
+        rotation to the path's heading would not turn the robot back from (within
+        ``rotate_to_heading_min_angle``, less twice :data:`FREE_HEADING_TOLERANCE`): with one
+        it would, in a corner, the two would turn the robot back and forth for good."""
         angle, _far = self._angle_to_path_ahead(pose, path_xy, path_yaw, path_s)
         wanted = pose[2] + angle
         widest = math.pi
@@ -544,7 +546,7 @@ class MppiOptimizer:
             for sign in (toward_yaw, -toward_yaw) if 0 < k < FREE_HEADINGS // 2 else (1.0,):
                 heading = wanted + sign * k * step
                 if not self._straight_collides(pose, heading, collision):
-                    return normalize_angle(heading)
+                    return normalize_angle(heading), normalize_angle(wanted)
         return None
 
     def _latch(self, angle: float) -> float:
