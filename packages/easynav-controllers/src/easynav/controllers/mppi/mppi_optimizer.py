@@ -347,12 +347,7 @@ class MppiOptimizer:
         if self._free_heading is not None:
             if self.last[0] != 0.0:
                 # Braking first, and easing any turn: the turn in place starts from a standstill.
-                v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
-                    self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
-                                                 * elapsed)
-                w = math.copysign(max(0.0, abs(self.last[1]) - limits.max_angular_decel
-                                      * elapsed), self.last[1])
-                return self._apply(v, w, TURNING_TO_FREE_HEADING)
+                return self._apply(*self._braking(limits, elapsed), TURNING_TO_FREE_HEADING)
             # Through the path's direction (where the search started), never round the back:
             # the rotation to the path's heading would take over there and turn it back.
             error = (normalize_angle(self._free_heading - self._free_reference)
@@ -443,9 +438,7 @@ class MppiOptimizer:
                 # Nothing safe in reach: brake and start the next optimisation afresh.
                 self.sequence[:] = 0.0
                 self.last_batch = batch
-                v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
-                    self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
-                                                 * elapsed)
+                v = self._braking(limits, elapsed)[0]
                 w = 0.0
                 if v == 0.0:
                     # Stopped: turn on the spot towards the path ahead (a disc turning in place
@@ -473,12 +466,7 @@ class MppiOptimizer:
                     FREE_HEADING_TOLERANCE):
                 self._free_heading, self._free_reference = found
                 self.sequence[:] = 0.0
-                v = max(0.0, self.last[0] - limits.max_linear_decel * elapsed) if (
-                    self.last[0] > 0.0) else min(0.0, self.last[0] + limits.max_linear_decel
-                                                 * elapsed)
-                w = math.copysign(max(0.0, abs(self.last[1]) - limits.max_angular_decel
-                                      * elapsed), self.last[1])
-                return self._apply(v, w, TURNING_TO_FREE_HEADING)
+                return self._apply(*self._braking(limits, elapsed), TURNING_TO_FREE_HEADING)
         self.sequence[:, 0] = v_seq[0]
         self.sequence[:, 1] = w_seq[0]
         optimal = np.column_stack((ox[0], oy[0], oyaw[0]))
@@ -495,6 +483,13 @@ class MppiOptimizer:
         if math.hypot(tx - x0, ty - y0) > 1e-3:
             return normalize_angle(math.atan2(ty - y0, tx - x0) - yaw0), True
         return normalize_angle(path_yaw[0] - yaw0), False
+
+    def _braking(self, limits: RobotLimits, elapsed: float) -> tuple[float, float]:
+        """The last command eased towards a standstill within the decelerations."""
+        v, w = self.last
+        v = max(0.0, v - limits.max_linear_decel * elapsed) if v > 0.0 else min(
+            0.0, v + limits.max_linear_decel * elapsed)
+        return v, math.copysign(max(0.0, abs(w) - limits.max_angular_decel * elapsed), w)
 
     def _forget_free_heading(self) -> None:
         self._free_heading: float | None = None  # the yaw turned to when stuck
