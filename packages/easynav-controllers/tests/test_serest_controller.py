@@ -24,7 +24,8 @@ from easynav.controllers.obstacle_distance import RobotWay, closest_lethal_dista
 from easynav.controllers.serest_controller import SerestController
 from easynav.controllers.serest_tracker import SEREST_DEFAULTS, TURN_PROBE_STEP, SerestTracker
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import PluginConfigurationError
+from easynav.core.plugins import MapsManagerBase, PluginConfigurationError
+from easynav.core.plugins.compatibility import compatibility_errors
 from easynav.core.robot import RobotLimits
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D, TwistStamped
 
@@ -255,6 +256,34 @@ def test_without_map_the_command_is_zero():
     serest.update_rt(nav_state)
     assert serest.state == "no_map"
     assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero()
+
+
+class NavMapOnly(MapsManagerBase):  # as the NavMap maps manager: it writes ``map.navmap`` only
+    PROVIDES_MAPS = ("navmap",)
+
+
+class CostmapWriter(MapsManagerBase):
+    PROVIDES_MAPS = ("costmap",)
+
+
+def test_a_maps_manager_without_a_navstate_map_is_refused_before_starting():
+    # Beside the NavMap maps manager alone SeReST never moved (it needs NavState ``map``):
+    # configure, so ``easynav check``, says so and names both plugins.
+    serest = ("serest", "easynav_serest_controller/SerestController", SerestController)
+    errors = compatibility_errors({
+        "maps_manager_node": [("navmap", "pkg/NavMapOnly", NavMapOnly)],
+        "controller_node": [serest],
+    })
+    assert errors == [
+        "controller_node.serest [easynav_serest_controller/SerestController] needs a map of "
+        "type simple_map or costmap or gridmap, but maps_manager_node.navmap [pkg/NavMapOnly] "
+        "provides navmap"
+    ]
+    assert compatibility_errors({
+        "maps_manager_node": [("navmap", "pkg/NavMapOnly", NavMapOnly),
+                              ("costmap", "pkg/CostmapWriter", CostmapWriter)],
+        "controller_node": [serest],
+    }) == []
 
 
 def test_runtime_limit_and_parameter_changes_take_effect_at_once():

@@ -72,7 +72,8 @@ class SerestController(ControllerMethodBase):
     beside it stopped for good.
 
     NavState: reads ``path``, ``robot_pose``, ``map`` (required, as in the original: absent, the
-    command is zero), ``closest_obstacle_distance``, ``goal_tolerance.position|yaw`` (preferred
+    command is zero; so a maps manager that writes it is required: ``NEEDS_MAPS``),
+    ``closest_obstacle_distance``, ``goal_tolerance.position|yaw`` (preferred
     to ``goal_pos_tol`` / ``goal_yaw_tol_deg``); writes ``cmd_vel`` (node clock stamp, robot
     footprint frame) and the ``serest.debug.*`` values.
 
@@ -131,6 +132,11 @@ class SerestController(ControllerMethodBase):
     )
     READS = (PATH, ROBOT_POSE, MAP, CLOSEST_OBSTACLE_DISTANCE, GOAL_TOLERANCE_POSITION,
              GOAL_TOLERANCE_YAW)
+    #: As the original, no command without a NavState ``map``: the representations the maps
+    #: managers write there. The NavMap maps manager writes ``map.navmap`` only; beside it alone
+    #: SeReST stood still until the mission timed out (integration matrix, campus), where now
+    #: configure (so ``easynav check``) refuses the pair.
+    NEEDS_MAPS = ("simple_map", "costmap", "gridmap")
     #: The original's own limits and the robot_limits field each stands for (controller_node
     #: applies them where robot_limits does not set that field).
     DEPRECATED_LIMITS = DEPRECATED_LIMITS
