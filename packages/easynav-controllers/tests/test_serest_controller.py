@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import math
 
 import numpy as np
@@ -24,7 +25,7 @@ from easynav.controllers.obstacle_distance import RobotWay, closest_lethal_dista
 from easynav.controllers.serest_controller import SerestController
 from easynav.controllers.serest_tracker import SEREST_DEFAULTS, TURN_PROBE_STEP, SerestTracker
 from easynav.core.nav_state import NavState
-from easynav.core.plugins import MapsManagerBase, PluginConfigurationError
+from easynav.core.plugins import PluginConfigurationError
 from easynav.core.plugins.compatibility import compatibility_errors
 from easynav.core.robot import RobotLimits
 from easynav.core.types import LETHAL_OBSTACLE, Costmap2D, TwistStamped
@@ -258,32 +259,36 @@ def test_without_map_the_command_is_zero():
     assert nav_state.get("cmd_vel", TwistStamped).twist.is_zero()
 
 
-class NavMapOnly(MapsManagerBase):  # as the NavMap maps manager: it writes ``map.navmap`` only
-    PROVIDES_MAPS = ("navmap",)
+#: The maps managers that write NavState ``map`` (module, class) and the one that does not.
+WRITES_MAP = (
+    ("simple_maps_manager", "SimpleMapsManager"),
+    ("costmap.costmap_maps_manager", "CostmapMapsManager"),
+    ("voxel.octomap_maps_manager", "OctomapMapsManager"),
+    ("voxel.bonxai_maps_manager", "BonxaiMapsManager"),
+    ("gridmap.gridmap_maps_manager", "GridmapMapsManager"),
+)
 
 
-class CostmapWriter(MapsManagerBase):
-    PROVIDES_MAPS = ("costmap",)
+def test_beside_a_maps_manager_without_a_navstate_map_configure_refuses_it():
+    # Beside the NavMap maps manager alone (it writes ``map.navmap``) SeReST never moved: the
+    # compatibility check of configure, so of ``easynav check``, refuses the pair, naming both.
+    pytest.importorskip("easynav.maps")
 
+    def errors_beside(module: str, name: str) -> list[str]:
+        cls = getattr(importlib.import_module(f"easynav.maps.{module}"), name)
+        return compatibility_errors({
+            "maps_manager_node": [("maps", f"pkg/{name}", cls)],
+            "controller_node": [("serest", "easynav_serest_controller/SerestController",
+                                 SerestController)],
+        })
 
-def test_a_maps_manager_without_a_navstate_map_is_refused_before_starting():
-    # Beside the NavMap maps manager alone SeReST never moved (it needs NavState ``map``):
-    # configure, so ``easynav check``, says so and names both plugins.
-    serest = ("serest", "easynav_serest_controller/SerestController", SerestController)
-    errors = compatibility_errors({
-        "maps_manager_node": [("navmap", "pkg/NavMapOnly", NavMapOnly)],
-        "controller_node": [serest],
-    })
-    assert errors == [
+    for module, name in WRITES_MAP:
+        assert errors_beside(module, name) == [], name
+    assert errors_beside("navmap.navmap_maps_manager", "NavMapMapsManager") == [
         "controller_node.serest [easynav_serest_controller/SerestController] needs a map of "
-        "type simple_map or costmap or gridmap, but maps_manager_node.navmap [pkg/NavMapOnly] "
-        "provides navmap"
+        "type simple_map or costmap or gridmap, but maps_manager_node.maps "
+        "[pkg/NavMapMapsManager] provides navmap"
     ]
-    assert compatibility_errors({
-        "maps_manager_node": [("navmap", "pkg/NavMapOnly", NavMapOnly),
-                              ("costmap", "pkg/CostmapWriter", CostmapWriter)],
-        "controller_node": [serest],
-    }) == []
 
 
 def test_runtime_limit_and_parameter_changes_take_effect_at_once():

@@ -72,7 +72,7 @@ class SerestController(ControllerMethodBase):
     beside it stopped for good.
 
     NavState: reads ``path``, ``robot_pose``, ``map`` (required, as in the original: absent, the
-    command is zero; so a maps manager that writes it is required: ``NEEDS_MAPS``),
+    command is zero; hence ``NEEDS_MAPS``, the maps managers that write it),
     ``closest_obstacle_distance``, ``goal_tolerance.position|yaw`` (preferred
     to ``goal_pos_tol`` / ``goal_yaw_tol_deg``); writes ``cmd_vel`` (node clock stamp, robot
     footprint frame) and the ``serest.debug.*`` values.
