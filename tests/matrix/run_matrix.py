@@ -64,6 +64,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from matrix import (  # noqa: E402 (the folder is not a package)
     LOST_LOCALISATION,
+    OVERLOADED_ODOMETRY_AGE_MS,
     ROOT,
     WORLDS,
     Outcome,
@@ -73,6 +74,7 @@ from matrix import (  # noqa: E402 (the folder is not a package)
     failure,
     load_findings,
     markdown,
+    odometry_lag,
     run_combination,
     unmatched_plugins,
 )
@@ -137,6 +139,13 @@ def stale_rows(combos, kept: dict[str, dict], fingerprints: dict[str, str]) -> s
             and kept[c.name].get("params") != fingerprints[c.name]}
 
 
+def overloaded_rows(kept: dict[str, dict]) -> set[str]:
+    """The kept rows that ran faster than real time overloaded (:func:`matrix.odometry_lag`):
+    they tested the machine, not the combination, and run again at x1."""
+    return {name for name, row in kept.items()
+            if float(row.get("speed_up", 1.0)) > 1.0 and odometry_lag(row.get("summary") or {})}
+
+
 def source_commit() -> str:
     """The commit the runs use (short hash, ``+changes`` when the tree differs from it): a row
     kept from an earlier part of the matrix says which code it ran."""
@@ -178,10 +187,11 @@ def _stopped_half_way(row: dict) -> bool:
             or row.get("summary", {}).get("final_state") == "INTERRUPTED")
 
 
-def _run_in_process(name: str, run_dir: Path, args: argparse.Namespace) -> dict:
+def _run_in_process(name: str, run_dir: Path, args: argparse.Namespace,
+                    speed_up: float) -> dict:
     """One combination in a process of its own (its own ROS domain, its own interpreter)."""
     cmd = [sys.executable, __file__, "--run-one", name, "--run-dir", str(run_dir),
-           "--speed-up", str(args.speed_up), "--worlds", args.worlds]
+           "--speed-up", str(speed_up), "--worlds", args.worlds]
     # A session of its own: Ctrl-C in the terminal stops the runner (which lets the runs in
     # progress finish and be kept), not the missions half-way, which would be kept as failures.
     done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ),
@@ -252,17 +262,19 @@ def main(argv: list[str]) -> int:
     fingerprints = {c.name: params_fingerprint(c) for c in combos
                     if not args.report or c.name in kept}
     stale = stale_rows(combos, kept, fingerprints)
+    overloaded = overloaded_rows(kept) - stale
     again = [part for part in args.again.split(",") if part]
     if args.report:
         todo = []
     elif again:
         todo = [c for c in combos if any(part in c.name for part in again)]
     else:
-        todo = [c for c in combos if c.name not in kept or c.name in stale]
-    done_before = sum(c.name in kept for c in combos) - len(stale)
+        todo = [c for c in combos if c.name not in kept or c.name in stale | overloaded]
+    done_before = sum(c.name in kept for c in combos) - len(stale | overloaded)
     print(f"{len(combos)} combinations: {done_before} done in {results_path}, {len(stale)} "
-          f"kept there with other params (run again), {len(todo)} to run, {args.jobs} at a time",
-          flush=True)
+          f"kept there with other params (run again), "
+          f"{sum(c.name in overloaded for c in combos)} overloaded faster than real time (run "
+          f"again at x1), {len(todo)} to run, {args.jobs} at a time", flush=True)
     started = datetime.now(timezone.utc)
     commit = source_commit()
     work = Path(tempfile.mkdtemp(prefix="easynav-matrix-"))
@@ -272,11 +284,14 @@ def main(argv: list[str]) -> int:
     def run(index_combo: tuple[int, object]) -> None:
         i, combo = index_combo
         t0 = time.monotonic()
-        row = _run_in_process(combo.name, work / f"{i:03d}", args)
+        # A row overloaded faster than real time runs again in real time (faster, it would only
+        # be overloaded again).
+        speed_up = min(args.speed_up, 1.0) if combo.name in overloaded else args.speed_up
+        row = _run_in_process(combo.name, work / f"{i:03d}", args, speed_up)
         row["seconds"] = round(time.monotonic() - t0, 1)
         row["commit"] = commit
         row["params"] = fingerprints[combo.name]
-        row["speed_up"] = args.speed_up
+        row["speed_up"] = speed_up
         row["finished"] = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
         run_dir = row.pop("run_dir", "")  # a temporary folder: not kept in the row
         if _stopped_half_way(row):  # a mission killed on its own is no result: run it again
@@ -288,9 +303,16 @@ def main(argv: list[str]) -> int:
                 f.write(json.dumps(row) + "\n")
             kept[combo.name] = row
             finished[0] += 1
-            outcome = Outcome(combo, row["exit_code"], row["summary"], row["error"])
-            said = ("green" if outcome.green
-                    else f"FAILED ({failure(outcome)}; the run: {run_dir})")
+            outcome = Outcome(combo, row["exit_code"], row["summary"], row["error"],
+                              speed_up=speed_up)
+            if outcome.slower:
+                said = (f"overloaded at x{speed_up:g} (EasyNav served the odometry "
+                        f"{odometry_lag(row['summary']):.0f} ms late, median; more than "
+                        f"{OVERLOADED_ODOMETRY_AGE_MS:g} ms): to run again at x1")
+            elif outcome.green:
+                said = "green"
+            else:
+                said = f"FAILED ({failure(outcome)}; the run: {run_dir})"
             if outcome.green:  # its logs and picture are kept for failures only (2.5 MB a run)
                 shutil.rmtree(work / f"{i:03d}", ignore_errors=True)
             print(f"[{finished[0]}/{len(todo)}] {combo.name}: {said} ({row['seconds']:.0f} s)",
@@ -308,9 +330,11 @@ def main(argv: list[str]) -> int:
     finally:
         pool.shutdown(wait=True, cancel_futures=True)  # queued runs never start
     stale = stale_rows(combos, kept, fingerprints)  # the runs of this call are not
+    overloaded = overloaded_rows(kept) - stale  # they may be, in real time too
     outcomes = [
         Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"],
-                ran=_ran(kept[c.name]), stale=c.name in stale)
+                ran=_ran(kept[c.name]), stale=c.name in stale,
+                speed_up=float(kept[c.name].get("speed_up", 1.0)))
         for c in combos if c.name in kept
     ]
     commits: dict[str, int] = {}
@@ -350,7 +374,13 @@ def main(argv: list[str]) -> int:
         "`safety.rt_monitor.max_period_factor` (2) periods after the previous one, from "
         "EasyNav's activation on; run: the commit and the speed-up the row ran with. A row "
         "kept from a run whose params the combination no longer composes to (a params file "
-        "retuned since) is marked stale: it runs again with the next `make matrix`.",
+        "retuned since) is marked stale: it runs again with the next `make matrix`. A run "
+        "in which EasyNav served the odometry transform more than "
+        f"{OVERLOADED_ODOMETRY_AGE_MS:g} ms late (median, simulated time) was overloaded: "
+        "the machine could not keep up, and the stack drove on a TF tree that much in the "
+        "past (laser scans drawn with an old pose, off the walls). Faster than real time, "
+        "such a run tested the machine, not the combination: it is marked overloaded and "
+        "runs again at x1 with the next `make matrix`; in real time it fails.",
         "",
         (f"- date: {started:%Y-%m-%d %H:%M} UTC, written from {results_path.name} (nothing run)"
          if args.report else
@@ -360,8 +390,11 @@ def main(argv: list[str]) -> int:
         "- this run: "
         + ("the covering slice only (`--slice`)" if args.slice else "every combination")
         + (f" whose name contains {args.only}" if args.only else "")
-        + f", worlds {args.worlds}: {len(outcomes) - len(stale)} of {len(combos)} runs done"
-        + (f" ({len(stale)} more kept stale: to run again)" if stale else ""),
+        + f", worlds {args.worlds}: {sum(not o.to_run_again for o in outcomes)} of "
+        f"{len(combos)} runs done"
+        + (f" ({len(stale)} more kept stale: to run again)" if stale else "")
+        + (f" ({sum(o.slower and not o.stale for o in outcomes)} more kept overloaded faster "
+           "than real time: to run again at x1)" if overloaded else ""),
         "- code of the rows: "
         + (", ".join(f"{key} ({n} rows)" for key, n in sorted(commits.items())) or "none yet"),
         "- speed-up of the rows: "
@@ -371,7 +404,7 @@ def main(argv: list[str]) -> int:
     Path(args.output).write_text(markdown(outcomes, header, unmatched, findings))
     print(f"wrote {args.output}")
     return 0 if len(outcomes) == len(combos) and all(
-        o.green and not o.stale for o in outcomes) else 1
+        o.green and not o.to_run_again for o in outcomes) else 1
 
 
 if __name__ == "__main__":
