@@ -262,7 +262,7 @@ def main(argv: list[str]) -> int:
     fingerprints = {c.name: params_fingerprint(c) for c in combos
                     if not args.report or c.name in kept}
     stale = stale_rows(combos, kept, fingerprints)
-    overloaded = overloaded_rows(kept) - stale
+    overloaded = {c.name for c in combos if c.name in kept} & overloaded_rows(kept) - stale
     again = [part for part in args.again.split(",") if part]
     if args.report:
         todo = []
@@ -273,8 +273,8 @@ def main(argv: list[str]) -> int:
     done_before = sum(c.name in kept for c in combos) - len(stale | overloaded)
     print(f"{len(combos)} combinations: {done_before} done in {results_path}, {len(stale)} "
           f"kept there with other params (run again), "
-          f"{sum(c.name in overloaded for c in combos)} overloaded faster than real time (run "
-          f"again at x1), {len(todo)} to run, {args.jobs} at a time", flush=True)
+          f"{len(overloaded)} overloaded faster than real time (run again at x1), {len(todo)} "
+          f"to run, {args.jobs} at a time", flush=True)
     started = datetime.now(timezone.utc)
     commit = source_commit()
     work = Path(tempfile.mkdtemp(prefix="easynav-matrix-"))
@@ -330,7 +330,7 @@ def main(argv: list[str]) -> int:
     finally:
         pool.shutdown(wait=True, cancel_futures=True)  # queued runs never start
     stale = stale_rows(combos, kept, fingerprints)  # the runs of this call are not
-    overloaded = overloaded_rows(kept) - stale  # they may be, in real time too
+    overloaded = {c.name for c in combos if c.name in kept} & overloaded_rows(kept) - stale
     outcomes = [
         Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"],
                 ran=_ran(kept[c.name]), stale=c.name in stale,
