@@ -19,7 +19,9 @@ Usage: .venv/bin/python tests/matrix/run_matrix.py [--slice] [--worlds home,depo
              call skips the combinations already there, so the full matrix (a thousand
              missions, more than a day of a 2-core machine) runs in parts, on any machine
              with a clone: stop it at any time (Ctrl-C or SIGTERM: runs in progress finish
-             and are kept, queued ones do not start), commit the file, start it again.
+             and are kept, queued ones do not start), commit the file, start it again. It
+             runs again the rows kept stale (run with params since changed) and those kept
+             overloaded faster than real time (these at x1; docs/matrix.md says why).
              docs/matrix.md is written from the file; each row names the commit it ran.
   --fresh    forget the results file first
   --only S   only the combinations whose name contains one of the comma-separated S
@@ -75,6 +77,7 @@ from matrix import (  # noqa: E402 (the folder is not a package)
     load_findings,
     markdown,
     odometry_lag,
+    overloaded_fast,
     run_combination,
     unmatched_plugins,
 )
@@ -143,7 +146,7 @@ def overloaded_rows(kept: dict[str, dict]) -> set[str]:
     """The kept rows that ran faster than real time overloaded (:func:`matrix.odometry_lag`):
     they tested the machine, not the combination, and run again at x1."""
     return {name for name, row in kept.items()
-            if float(row.get("speed_up", 1.0)) > 1.0 and odometry_lag(row.get("summary") or {})}
+            if overloaded_fast(row.get("summary") or {}, float(row.get("speed_up", 1.0)))}
 
 
 def source_commit() -> str:
@@ -262,7 +265,10 @@ def main(argv: list[str]) -> int:
     fingerprints = {c.name: params_fingerprint(c) for c in combos
                     if not args.report or c.name in kept}
     stale = stale_rows(combos, kept, fingerprints)
-    overloaded = {c.name for c in combos if c.name in kept} & overloaded_rows(kept) - stale
+    # A row overloaded faster than real time runs again at x1 (faster, it would only be
+    # overloaded again), stale or not; it is counted once, as stale when it is both.
+    rerun_at_x1 = {c.name for c in combos if c.name in kept} & overloaded_rows(kept)
+    overloaded = rerun_at_x1 - stale
     again = [part for part in args.again.split(",") if part]
     if args.report:
         todo = []
@@ -272,9 +278,8 @@ def main(argv: list[str]) -> int:
         todo = [c for c in combos if c.name not in kept or c.name in stale | overloaded]
     done_before = sum(c.name in kept for c in combos) - len(stale | overloaded)
     print(f"{len(combos)} combinations: {done_before} done in {results_path}, {len(stale)} "
-          f"kept there with other params (run again), "
-          f"{len(overloaded)} overloaded faster than real time (run again at x1), {len(todo)} "
-          f"to run, {args.jobs} at a time", flush=True)
+          f"kept there with other params, {len(overloaded)} overloaded faster than real time "
+          f"(both to run again), {len(todo)} to run, {args.jobs} at a time", flush=True)
     started = datetime.now(timezone.utc)
     commit = source_commit()
     work = Path(tempfile.mkdtemp(prefix="easynav-matrix-"))
@@ -284,9 +289,9 @@ def main(argv: list[str]) -> int:
     def run(index_combo: tuple[int, object]) -> None:
         i, combo = index_combo
         t0 = time.monotonic()
-        # A row overloaded faster than real time runs again in real time (faster, it would only
-        # be overloaded again).
-        speed_up = min(args.speed_up, 1.0) if combo.name in overloaded else args.speed_up
+        # --again runs at the speed asked for (a row retested at x4 after a fix).
+        speed_up = (min(args.speed_up, 1.0) if combo.name in rerun_at_x1 and not again
+                    else args.speed_up)
         row = _run_in_process(combo.name, work / f"{i:03d}", args, speed_up)
         row["seconds"] = round(time.monotonic() - t0, 1)
         row["commit"] = commit
@@ -305,18 +310,18 @@ def main(argv: list[str]) -> int:
             finished[0] += 1
             outcome = Outcome(combo, row["exit_code"], row["summary"], row["error"],
                               speed_up=speed_up)
-            if outcome.slower:
-                said = (f"overloaded at x{speed_up:g} (EasyNav served the odometry "
-                        f"{odometry_lag(row['summary']):.0f} ms late, median; more than "
-                        f"{OVERLOADED_ODOMETRY_AGE_MS:g} ms): to run again at x1")
+            if outcome.overloaded_fast:
+                said = (f"overloaded (EasyNav's TF listener handled odom → robot "
+                        f"{odometry_lag(row['summary']):.0f} ms after its stamp, median; more "
+                        f"than {OVERLOADED_ODOMETRY_AGE_MS:g} ms): to run again at x1")
             elif outcome.green:
                 said = "green"
             else:
                 said = f"FAILED ({failure(outcome)}; the run: {run_dir})"
             if outcome.green:  # its logs and picture are kept for failures only (2.5 MB a run)
                 shutil.rmtree(work / f"{i:03d}", ignore_errors=True)
-            print(f"[{finished[0]}/{len(todo)}] {combo.name}: {said} ({row['seconds']:.0f} s)",
-                  flush=True)
+            print(f"[{finished[0]}/{len(todo)}] {combo.name}: {said} ({row['seconds']:.0f} s "
+                  f"at x{speed_up:g})", flush=True)
 
     # SIGTERM (a job's time limit, `kill`) stops it the way Ctrl-C does.
     signal.signal(signal.SIGTERM, _interrupt)
@@ -330,7 +335,7 @@ def main(argv: list[str]) -> int:
     finally:
         pool.shutdown(wait=True, cancel_futures=True)  # queued runs never start
     stale = stale_rows(combos, kept, fingerprints)  # the runs of this call are not
-    overloaded = {c.name for c in combos if c.name in kept} & overloaded_rows(kept) - stale
+    overloaded = ({c.name for c in combos if c.name in kept} & overloaded_rows(kept)) - stale
     outcomes = [
         Outcome(c, kept[c.name]["exit_code"], kept[c.name]["summary"], kept[c.name]["error"],
                 ran=_ran(kept[c.name]), stale=c.name in stale,
@@ -375,8 +380,9 @@ def main(argv: list[str]) -> int:
         "EasyNav's activation on; run: the commit and the speed-up the row ran with. A row "
         "kept from a run whose params the combination no longer composes to (a params file "
         "retuned since) is marked stale: it runs again with the next `make matrix`. A run "
-        "in which EasyNav served the odometry transform more than "
-        f"{OVERLOADED_ODOMETRY_AGE_MS:g} ms late (median, simulated time) was overloaded: "
+        "in which EasyNav's TF listener handled the odom → robot transforms more than "
+        f"{OVERLOADED_ODOMETRY_AGE_MS:g} ms after their stamps (median, simulated time) was "
+        "overloaded: "
         "the machine could not keep up, and the stack drove on a TF tree that much in the "
         "past (laser scans drawn with an old pose, off the walls). Faster than real time, "
         "such a run tested the machine, not the combination: it is marked overloaded and "
@@ -392,9 +398,10 @@ def main(argv: list[str]) -> int:
         + (f" whose name contains {args.only}" if args.only else "")
         + f", worlds {args.worlds}: {sum(not o.to_run_again for o in outcomes)} of "
         f"{len(combos)} runs done"
-        + (f" ({len(stale)} more kept stale: to run again)" if stale else "")
-        + (f" ({sum(o.slower and not o.stale for o in outcomes)} more kept overloaded faster "
-           "than real time: to run again at x1)" if overloaded else ""),
+        + (" (" + "; ".join(
+            ([f"{len(stale)} more kept stale: to run again"] if stale else [])
+            + ([f"{len(overloaded)} more kept overloaded faster than real time: to run again "
+                "at x1"] if overloaded else [])) + ")" if stale or overloaded else ""),
         "- code of the rows: "
         + (", ".join(f"{key} ({n} rows)" for key, n in sorted(commits.items())) or "none yet"),
         "- speed-up of the rows: "

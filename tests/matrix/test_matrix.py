@@ -210,45 +210,64 @@ def test_the_report_marks_a_stale_row_and_says_what_each_row_ran_with():
 
 
 def test_a_run_overloaded_faster_than_real_time_is_to_run_again_and_in_real_time_fails():
-    """The campus row of fusion + the costmap + OMPL + SeReST at x4: EasyNav served the odometry
-    1.4 s late (median), drew its scans metres off the walls and drove 447 m of a 195 m tour,
-    green; at x1 it drove 196 m. Such a row is not evidence about the combination."""
+    """The campus row of fusion + the costmap + OMPL + SeReST at x4: EasyNav's TF listener
+    handled odom → robot 1.4 s after its stamp (median), the scans were drawn metres off the
+    walls and the robot drove 447 m of a 195 m tour, green; at x1 it drove 196 m. Such a row is
+    not evidence about the combination."""
     combo = Combination("m/M", "l/L", "p/P", "c/C", "campus")
     summary = {"success": True, "waypoints": 5, "reached": 5,
                "odometry_age": {"transforms": 65678, "median_ms": 1395.0, "p99_ms": 1760.0}}
     at_x4 = Outcome(combo, 0, summary, ran="522025f x4", speed_up=4.0)
-    assert at_x4.slower and at_x4.to_run_again and not at_x4.green
+    assert at_x4.overloaded_fast and at_x4.to_run_again and not at_x4.green
     assert verdict(at_x4) == (
-        "**overloaded** at x4: EasyNav served the odometry 1395 ms late (median), the run "
-        "tested the machine, not the combination; to run again at x1")
+        "**overloaded** at x4: EasyNav's TF listener handled odom → robot 1395 ms after its "
+        "stamp (median, simulated), the run tested the machine, not the combination; to run "
+        "again at x1")
     at_x1 = Outcome(combo, 0, summary, ran="522025f x1")
-    assert not at_x1.slower and not at_x1.green
+    assert not at_x1.overloaded_fast and not at_x1.to_run_again and not at_x1.green
     assert verdict(at_x1) == (
-        "**FAILED** (not looked into yet): overloaded: EasyNav served the odometry 1395 ms late "
-        "(median; more than 250 ms)")
+        "**FAILED** (not looked into yet): overloaded: EasyNav's TF listener handled odom → "
+        "robot 1395 ms after its stamp (median, simulated; more than 250 ms)")
     kept_up = dict(summary, odometry_age={"median_ms": 20.0, "p99_ms": 1230.0})
     assert Outcome(combo, 0, kept_up, speed_up=4.0).green  # a late tail alone is no overload
     assert Outcome(combo, 0, {"success": True}, speed_up=4.0).green  # not measured (old rows)
     text = markdown([at_x4, Outcome(combo, 0, kept_up, ran="3b39a3e x4", speed_up=4.0)], "# h")
     assert ("1 of 1 runs green; of the 0 failed, 0 explained (tests/matrix/findings.yaml); "
             "and 1 overloaded runs (faster than real time: to run again at x1).") in text
+    both = Outcome(combo, 0, summary, speed_up=4.0, stale=True)  # counted once, as stale
+    assert markdown([both], "# h").endswith(
+        "0 of 0 runs green; of the 0 failed, 0 explained (tests/matrix/findings.yaml); and 1 "
+        "stale runs (run with params changed since: to run again).\n")
+
+
+def _kept_rows(path, rows):
+    """Write ``rows`` (combination, summary, speed-up, params fingerprint) as a results file."""
+    import json
+
+    path.write_text("".join(json.dumps(
+        {"name": c.name, "exit_code": 0, "summary": summary, "error": "", "speed_up": speed,
+         "params": fingerprint}) + "\n" for c, summary, speed, fingerprint in rows))
 
 
 def test_the_runner_runs_a_row_overloaded_faster_than_real_time_again_at_x1(tmp_path,
-                                                                            monkeypatch):
-    import json
-
+                                                                            monkeypatch,
+                                                                            capsys):
     import run_matrix
 
-    combos = combinations(("home",))[:3]
-    overloaded, kept_up, overloaded_x1 = combos
+    combos = combinations(("home",))[:6]
+    overloaded, kept_up, overloaded_x1, stale_overloaded, never_ran, elsewhere = combos
     late = {"success": True, "odometry_age": {"median_ms": 900.0}}
-    rows = [(overloaded, late, 4.0), (kept_up, {"success": True}, 4.0), (overloaded_x1, late, 1.0)]
+    fingerprint = run_matrix.params_fingerprint
     results = tmp_path / "results.jsonl"
-    results.write_text("".join(json.dumps(
-        {"name": c.name, "exit_code": 0, "summary": summary, "error": "", "speed_up": speed,
-         "params": run_matrix.params_fingerprint(c)}) + "\n" for c, summary, speed in rows))
-    assert run_matrix.overloaded_rows(run_matrix.load_results(results)) == {overloaded.name}
+    _kept_rows(results, [
+        (overloaded, late, 4.0, fingerprint(overloaded)),
+        (kept_up, {"success": True}, 4.0, fingerprint(kept_up)),
+        (overloaded_x1, late, 1.0, fingerprint(overloaded_x1)),  # a result: a failure
+        (stale_overloaded, late, 4.0, "retuned"),
+        (elsewhere, late, 4.0, fingerprint(elsewhere)),  # not among this call's combinations
+    ])
+    assert run_matrix.overloaded_rows(run_matrix.load_results(results)) == {
+        overloaded.name, stale_overloaded.name, elsewhere.name}
     ran = []
 
     def run(name, run_dir, args, speed_up):
@@ -256,13 +275,27 @@ def test_the_runner_runs_a_row_overloaded_faster_than_real_time_again_at_x1(tmp_
         return {"name": name, "exit_code": 0, "summary": {"success": True}, "error": ""}
 
     monkeypatch.setattr(run_matrix, "_run_in_process", run)
-    monkeypatch.setattr(run_matrix, "combinations", lambda worlds: combos)
-    run_matrix.main(["--worlds", "home", "--speed-up", "4", "--results", str(results),
-                     "--output", str(tmp_path / "matrix.md")])
-    assert ran == [(overloaded.name, 1.0)]  # the x1 overload is a result: a failure
+    monkeypatch.setattr(run_matrix, "combinations", lambda worlds: combos[:5])
+    code = run_matrix.main(["--worlds", "home", "--speed-up", "4", "--results", str(results),
+                            "--output", str(tmp_path / "matrix.md")])
+    assert sorted(ran) == sorted([(overloaded.name, 1.0), (stale_overloaded.name, 1.0),
+                                  (never_ran.name, 4.0)])
+    assert capsys.readouterr().out.startswith(
+        "5 combinations: 2 done in " + str(results) + ", 1 kept there with other params, 1 "
+        "overloaded faster than real time (both to run again), 3 to run")
+    assert code == 1  # the row overloaded at x1 failed
     report = (tmp_path / "matrix.md").read_text()
-    assert "(not looked into yet): overloaded: EasyNav served the odometry 900 ms late" in report
-    assert "**overloaded** at x" not in report  # the x4 row ran again, green
+    assert ("(not looked into yet): overloaded: EasyNav's TF listener handled odom → robot 900 "
+            "ms after its stamp") in report
+    assert "**overloaded** at x" not in report  # the x4 rows ran again, green
+    assert ": 5 of 5 runs done\n" in report
+
+    # Asked for by name, a row runs at the speed asked for (retested at x4 after a fix).
+    _kept_rows(results, [(overloaded, late, 4.0, fingerprint(overloaded))])
+    ran.clear()
+    run_matrix.main(["--worlds", "home", "--speed-up", "4", "--again", overloaded.name,
+                     "--results", str(results), "--output", str(tmp_path / "matrix.md")])
+    assert ran == [(overloaded.name, 4.0)]
 
 
 def test_again_runs_only_the_rows_it_names(tmp_path, monkeypatch):
