@@ -386,7 +386,7 @@ def main(argv: list[str]) -> int:
         "the machine could not keep up, and the stack drove on a TF tree that much in the "
         "past (laser scans drawn with an old pose, off the walls). Faster than real time, "
         "such a run tested the machine, not the combination: it is marked overloaded and "
-        "runs again at x1 with the next `make matrix`; in real time it fails.",
+        "runs again at x1 with the next `make matrix`; in real time its verdict says so.",
         "",
         (f"- date: {started:%Y-%m-%d %H:%M} UTC, written from {results_path.name} (nothing run)"
          if args.report else

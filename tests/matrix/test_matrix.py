@@ -209,7 +209,7 @@ def test_the_report_marks_a_stale_row_and_says_what_each_row_ran_with():
            "and 1 stale runs (run with params changed since: to run again)." in text
 
 
-def test_a_run_overloaded_faster_than_real_time_is_to_run_again_and_in_real_time_fails():
+def test_a_run_overloaded_faster_than_real_time_is_to_run_again_and_in_real_time_says_so():
     """The campus row of fusion + the costmap + OMPL + SeReST at x4: EasyNav's TF listener
     handled odom → robot 1.4 s after its stamp (median), the scans were drawn metres off the
     walls and the robot drove 447 m of a 195 m tour, green; at x1 it drove 196 m. Such a row is
@@ -218,16 +218,21 @@ def test_a_run_overloaded_faster_than_real_time_is_to_run_again_and_in_real_time
     summary = {"success": True, "waypoints": 5, "reached": 5,
                "odometry_age": {"transforms": 65678, "median_ms": 1395.0, "p99_ms": 1760.0}}
     at_x4 = Outcome(combo, 0, summary, ran="522025f x4", speed_up=4.0)
-    assert at_x4.overloaded_fast and at_x4.to_run_again and not at_x4.green
+    assert at_x4.overloaded_fast and at_x4.to_run_again
     assert verdict(at_x4) == (
         "**overloaded** at x4: EasyNav's TF listener handled odom → robot 1395 ms after its "
         "stamp (median, simulated), the run tested the machine, not the combination; to run "
         "again at x1")
     at_x1 = Outcome(combo, 0, summary, ran="522025f x1")
-    assert not at_x1.overloaded_fast and not at_x1.to_run_again and not at_x1.green
+    assert not at_x1.overloaded_fast and not at_x1.to_run_again and at_x1.green
     assert verdict(at_x1) == (
-        "**FAILED** (not looked into yet): overloaded: EasyNav's TF listener handled odom → "
-        "robot 1395 ms after its stamp (median, simulated; more than 250 ms)")
+        "green, but overloaded: EasyNav's TF listener handled odom → robot 1395 ms after its "
+        "stamp (median, simulated; more than 250 ms)")
+    missed = Outcome(combo, 1, dict(summary, success=False, reached=4))
+    assert verdict(missed) == (
+        "**FAILED** (not looked into yet): 4 of 5 waypoints reached; overloaded: EasyNav's TF "
+        "listener handled odom → robot 1395 ms after its stamp (median, simulated; more than "
+        "250 ms)")
     kept_up = dict(summary, odometry_age={"median_ms": 20.0, "p99_ms": 1230.0})
     assert Outcome(combo, 0, kept_up, speed_up=4.0).green  # a late tail alone is no overload
     assert Outcome(combo, 0, {"success": True}, speed_up=4.0).green  # not measured (old rows)
@@ -262,7 +267,7 @@ def test_the_runner_runs_a_row_overloaded_faster_than_real_time_again_at_x1(tmp_
     _kept_rows(results, [
         (overloaded, late, 4.0, fingerprint(overloaded)),
         (kept_up, {"success": True}, 4.0, fingerprint(kept_up)),
-        (overloaded_x1, late, 1.0, fingerprint(overloaded_x1)),  # a result: a failure
+        (overloaded_x1, late, 1.0, fingerprint(overloaded_x1)),  # a result
         (stale_overloaded, late, 4.0, "retuned"),
         (elsewhere, late, 4.0, fingerprint(elsewhere)),  # not among this call's combinations
     ])
@@ -283,10 +288,10 @@ def test_the_runner_runs_a_row_overloaded_faster_than_real_time_again_at_x1(tmp_
     assert capsys.readouterr().out.startswith(
         "5 combinations: 2 done in " + str(results) + ", 1 kept there with other params, 1 "
         "overloaded faster than real time (both to run again), 3 to run")
-    assert code == 1  # the row overloaded at x1 failed
+    assert code == 0  # every row green, none to run again
     report = (tmp_path / "matrix.md").read_text()
-    assert ("(not looked into yet): overloaded: EasyNav's TF listener handled odom → robot 900 "
-            "ms after its stamp") in report
+    assert ("| green, but overloaded: EasyNav's TF listener handled odom → robot 900 ms after "
+            "its stamp") in report
     assert "**overloaded** at x" not in report  # the x4 rows ran again, green
     assert ": 5 of 5 runs done\n" in report
 
