@@ -227,12 +227,12 @@ def test_a_run_overloaded_faster_than_real_time_is_to_run_again_and_in_real_time
     assert not at_x1.overloaded_fast and not at_x1.to_run_again and at_x1.green
     assert verdict(at_x1) == (
         "green, but overloaded: EasyNav's TF listener handled odom → robot 1395 ms after its "
-        "stamp (median, simulated; more than 250 ms)")
+        "stamp (median, simulated; more than 100 ms)")
     missed = Outcome(combo, 1, dict(summary, success=False, reached=4))
     assert verdict(missed) == (
         "**FAILED** (not looked into yet): 4 of 5 waypoints reached; overloaded: EasyNav's TF "
         "listener handled odom → robot 1395 ms after its stamp (median, simulated; more than "
-        "250 ms)")
+        "100 ms)")
     kept_up = dict(summary, odometry_age={"median_ms": 20.0, "p99_ms": 1230.0})
     assert Outcome(combo, 0, kept_up, speed_up=4.0).green  # a late tail alone is no overload
     assert Outcome(combo, 0, {"success": True}, speed_up=4.0).green  # not measured (old rows)
